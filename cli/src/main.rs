@@ -1,0 +1,71 @@
+//! The `surfmap` command line: `inspect`, `convert` and `metrics` over the geometry core.
+//! Exit codes: 0 success, 2 bad input (message on stderr), 1 internal failure.
+
+mod commands;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "surfmap", version, about = "Map one triangle mesh onto another of the same topology")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print a JSON summary of a mesh: counts, components, boundary loops, genus, bbox, warnings.
+    Inspect {
+        /// Mesh file (OBJ, OFF, PLY or STL; detected from content).
+        mesh: PathBuf,
+    },
+    /// Convert a mesh between formats (output format from the extension).
+    Convert { input: PathBuf, output: PathBuf },
+    /// Measure a map given as SOURCE re-embedded on TARGET (MAPPED has SOURCE's faces).
+    Metrics {
+        source: PathBuf,
+        target: PathBuf,
+        mapped: PathBuf,
+        /// JSON file `{"anchors": [[source_vertex, target_vertex], ...]}` (0-based).
+        #[arg(long)]
+        anchors: Option<PathBuf>,
+        /// Text file: one 0-based target vertex per line, one line per source vertex.
+        #[arg(long)]
+        gt: Option<PathBuf>,
+        /// Surface samples per direction for Hausdorff / RMS.
+        #[arg(long, default_value_t = 100_000)]
+        samples: usize,
+        /// Seed of the surface sampling.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() { ExitCode::from(2) } else { ExitCode::SUCCESS };
+        }
+    };
+    let result = match cli.command {
+        Command::Inspect { mesh } => commands::inspect(&mesh),
+        Command::Convert { input, output } => commands::convert(&input, &output),
+        Command::Metrics { source, target, mapped, anchors, gt, samples, seed } => {
+            commands::metrics(&source, &target, &mapped, anchors.as_deref(), gt.as_deref(), samples, seed)
+        }
+    };
+    match result {
+        Ok(out) => {
+            println!("{out}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("surfmap: error [{}]: {e}", e.code());
+            if e.is_input() { ExitCode::from(2) } else { ExitCode::from(1) }
+        }
+    }
+}

@@ -1,1 +1,9 @@
-//! linalg
+//! Sparse linear algebra for mesh Laplacians: edge weights (uniform, cotangent, mean value),
+//! triplet assembly with `sprs`, and fixed-boundary solvers on `faer`'s sparse Cholesky / LU
+//! with the symbolic factorization computed once and reused for every numeric factorization.
+
+mod solver;
+mod weights;
+
+pub use solver::{FixedBoundaryFactor, FixedBoundarySystem};
+pub use weights::{DirectedWeights, Weights, directed_weights};

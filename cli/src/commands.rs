@@ -1,28 +1,18 @@
 //! The subcommands: each returns the JSON (or text) to print, or a `geom::Error`.
 
 use geom::io::{self, ReadOptions};
-use geom::{Error, InputError, Result};
+use geom::{Error, InputError, Result, VertexId};
 use serde_json::json;
 use std::path::Path;
 
 fn read(path: &Path) -> Result<io::ReadResult> {
-    io::read_path(path, &ReadOptions::default())
-        .map_err(|e| match e {
-            Error::Input(InputError::Invalid(m)) => Error::Input(InputError::Invalid(m)),
-            Error::Input(i) => Error::Input(InputError::Invalid(format!("{}: {i}", path.display()))).with_code_of(i),
-            other => other,
-        })
-}
-
-trait WithCode {
-    fn with_code_of(self, i: InputError) -> Error;
-}
-impl WithCode for Error {
-    fn with_code_of(self, i: InputError) -> Error {
-        // Keep the original variant (and code); the path is added by the caller's message.
-        let _ = self;
-        Error::Input(i)
-    }
+    io::read_path(path, &ReadOptions::default()).map_err(|e| match e {
+        // Name the file in parse errors; keep the variant (and so the code).
+        Error::Input(InputError::Parse { format, location, message }) => {
+            Error::Input(InputError::Parse { format, location: format!("{}: {location}", path.display()), message })
+        }
+        other => other,
+    })
 }
 
 /// `surfmap inspect MESH`.
@@ -49,6 +39,33 @@ pub fn convert(input: &Path, output: &Path) -> Result<String> {
     .to_string())
 }
 
+/// Reads `{"anchors": [[s, t], ...]}`.
+fn read_anchors(path: &Path) -> Result<Vec<(VertexId, VertexId)>> {
+    #[derive(serde::Deserialize)]
+    struct AnchorFile {
+        anchors: Vec<(u32, u32)>,
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| InputError::Invalid(format!("cannot read {}: {e}", path.display())))?;
+    let f: AnchorFile = serde_json::from_str(&text)
+        .map_err(|e| InputError::Invalid(format!("{}: expected {{\"anchors\": [[s, t], ...]}}: {e}", path.display())))?;
+    Ok(f.anchors.into_iter().map(|(s, t)| (VertexId(s), VertexId(t))).collect())
+}
+
+/// Reads one 0-based target vertex per line.
+fn read_gt(path: &Path) -> Result<Vec<VertexId>> {
+    let text = std::fs::read_to_string(path).map_err(|e| InputError::Invalid(format!("cannot read {}: {e}", path.display())))?;
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            let t = l.split_whitespace().next().unwrap_or("");
+            t.parse::<u32>()
+                .map(VertexId)
+                .map_err(|_| InputError::Invalid(format!("{} line {}: expected a vertex index, found {t:?}", path.display(), i + 1)).into())
+        })
+        .collect()
+}
+
 /// `surfmap metrics SOURCE TARGET MAPPED`.
 pub fn metrics(
     source: &Path,
@@ -59,6 +76,12 @@ pub fn metrics(
     samples: usize,
     seed: u64,
 ) -> Result<String> {
-    let _ = (source, target, mapped, anchors, gt, samples, seed);
-    Err(Error::Internal("metrics not built yet".into()))
+    let s = read(source)?.mesh;
+    let t = read(target)?.mesh;
+    let m = read(mapped)?.mesh;
+    let anchors = anchors.map(read_anchors).transpose()?;
+    let gt = gt.map(read_gt).transpose()?;
+    let opts = geom::metrics::MetricsOptions { samples, seeds: (seed.wrapping_mul(2).wrapping_add(1), seed.wrapping_mul(2).wrapping_add(2)) };
+    let r = geom::metrics::evaluate_map(&s, &t, &m, anchors.as_deref(), gt.as_deref(), &opts)?;
+    serde_json::to_string_pretty(&r).map_err(|e| Error::Internal(e.to_string()))
 }

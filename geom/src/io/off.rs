@@ -120,8 +120,10 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
             all_tri = false;
             sizes = vec![3; f];
         }
-        for _ in 0..k {
-            let t = lx.token().ok_or_else(|| lx.err(format!("unexpected end of file in face {f}")))?;
+        for j in 0..k {
+            let t = lx
+                .inline_token()
+                .ok_or_else(|| lx.err(format!("face {f} declares {k} vertices but its line holds {j}")))?;
             let i = super::lex::parse_u64(t)
                 .filter(|&i| i <= u64::from(u32::MAX - 1))
                 .ok_or_else(|| lx.err(format!("invalid vertex index {:?} in face {f}", show(t))))?;

@@ -1,0 +1,142 @@
+//! Nearest-surface queries as `meshmetrics.py` makes them: the candidate faces of a query are
+//! those whose centroids are among its `k = 24` nearest (k-d tree, `kiddo`), and the closest
+//! point on each candidate comes from Ericson's region test, evaluated in the evaluator's order
+//! (interior, then edge regions AB, AC, BC, then vertex regions A, B, C), keeping the first
+//! strictly closer candidate. A distance is exact, or slightly too large when the true closest
+//! face is not among the candidates: exactly the evaluator's definition.
+
+use crate::error::{Error, Result};
+use crate::mesh::{FaceId, Mesh, P3, V3};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use std::num::NonZeroUsize;
+
+/// Candidates per query, as in the evaluator.
+pub const CANDIDATES: usize = 24;
+
+/// A k-nearest-centroid surface index.
+pub struct SurfaceIndex<'m> {
+    mesh: &'m Mesh,
+    tree: ImmutableKdTree<f64, 3>,
+    k: NonZeroUsize,
+}
+
+/// One query's answer.
+#[derive(Debug, Clone, Copy)]
+pub struct Nearest {
+    pub distance: f64,
+    pub face: FaceId,
+    pub point: P3,
+}
+
+#[inline]
+fn guard(x: f64) -> f64 {
+    if x.abs() < 1e-300 { 1e-300 } else { x }
+}
+
+/// Ericson's closest point on triangle (a, b, c), in the evaluator's evaluation order.
+pub(crate) fn closest_point_on_triangle(p: P3, a: P3, b: P3, c: P3) -> P3 {
+    let ab: V3 = b - a;
+    let ac: V3 = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(&ap);
+    let d2 = ac.dot(&ap);
+    let bp = p - b;
+    let d3 = ab.dot(&bp);
+    let d4 = ac.dot(&bp);
+    let cp = p - c;
+    let d5 = ab.dot(&cp);
+    let d6 = ac.dot(&cp);
+    let va = d3 * d6 - d5 * d4;
+    let vb = d5 * d2 - d1 * d6;
+    let vc = d1 * d4 - d3 * d2;
+    let denom = guard(va + vb + vc);
+    let v = vb / denom;
+    let w = vc / denom;
+    let mut res = a + ab * v + ac * w;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let t = d1 / guard(d1 - d3);
+        res = a + ab * t;
+    }
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let t = d2 / guard(d2 - d6);
+        res = a + ac * t;
+    }
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let t = (d4 - d3) / guard((d4 - d3) + (d5 - d6));
+        res = b + (c - b) * t;
+    }
+    if d1 <= 0.0 && d2 <= 0.0 {
+        res = a;
+    }
+    if d3 >= 0.0 && d4 <= d3 {
+        res = b;
+    }
+    if d6 >= 0.0 && d5 <= d6 {
+        res = c;
+    }
+    res
+}
+
+/// Face centroid as numpy computes `V[F].mean(axis=1)`.
+pub(crate) fn centroid(p: [P3; 3]) -> P3 {
+    P3::new((p[0].x + p[1].x + p[2].x) / 3.0, (p[0].y + p[1].y + p[2].y) / 3.0, (p[0].z + p[1].z + p[2].z) / 3.0)
+}
+
+impl<'m> SurfaceIndex<'m> {
+    /// Builds the k-d tree of face centroids.
+    ///
+    /// # Errors
+    /// `Error::Internal` if the tree cannot be built (no faces).
+    pub fn new(mesh: &'m Mesh) -> Result<Self> {
+        let cents: Vec<[f64; 3]> = (0..mesh.n_faces())
+            .map(|f| {
+                let c = centroid(mesh.face_points(FaceId::from_idx(f)));
+                [c.x, c.y, c.z]
+            })
+            .collect();
+        let tree = ImmutableKdTree::new_from_slice(&cents).map_err(|e| Error::Internal(format!("k-d tree: {e:?}")))?;
+        let k = NonZeroUsize::new(CANDIDATES.min(mesh.n_faces())).ok_or_else(|| Error::Internal("mesh has no faces".into()))?;
+        Ok(Self { mesh, tree, k })
+    }
+
+    /// Nearest point among the candidate faces.
+    pub fn query(&self, p: &P3) -> Nearest {
+        let cand = self.tree.query(&[p.x, p.y, p.z]).nearest_n::<SquaredEuclidean<f64>>(self.k).execute();
+        let mut best = Nearest { distance: f64::INFINITY, face: FaceId(0), point: *p };
+        for n in cand {
+            let f = FaceId(n.item);
+            let [a, b, c] = self.mesh.face_points(f);
+            let q = closest_point_on_triangle(*p, a, b, c);
+            let d = (q - p).norm();
+            if d < best.distance {
+                best = Nearest { distance: d, face: f, point: q };
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+
+    #[test]
+    fn closest_point_regions() {
+        let (a, b, c) = (P3::new(0., 0., 0.), P3::new(1., 0., 0.), P3::new(0., 1., 0.));
+        assert_eq!(closest_point_on_triangle(P3::new(0.2, 0.2, 1.0), a, b, c), P3::new(0.2, 0.2, 0.0));
+        assert_eq!(closest_point_on_triangle(P3::new(-1., -1., 0.), a, b, c), a);
+        assert_eq!(closest_point_on_triangle(P3::new(2., -1., 0.), a, b, c), b);
+        let q = closest_point_on_triangle(P3::new(1., 1., 0.), a, b, c);
+        assert!((q - P3::new(0.5, 0.5, 0.)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn vertices_of_a_sphere_are_on_it() {
+        let s = shapes::icosphere(2);
+        let idx = SurfaceIndex::new(&s).unwrap();
+        for p in s.positions() {
+            assert!(idx.query(p).distance < 1e-15);
+        }
+    }
+}

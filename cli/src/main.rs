@@ -22,7 +22,13 @@ enum Command {
         mesh: PathBuf,
     },
     /// Convert a mesh between formats (output format from the extension).
-    Convert { input: PathBuf, output: PathBuf },
+    Convert {
+        input: PathBuf,
+        output: PathBuf,
+        /// Split every triangle into four at edge midpoints, this many times.
+        #[arg(long, default_value_t = 0)]
+        subdivide: usize,
+    },
     /// Measure a map given as SOURCE re-embedded on TARGET (MAPPED has SOURCE's faces).
     Metrics {
         source: PathBuf,
@@ -53,7 +59,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Inspect { mesh } => commands::inspect(&mesh),
-        Command::Convert { input, output } => commands::convert(&input, &output),
+        Command::Convert { input, output, subdivide } => commands::convert(&input, &output, subdivide),
         Command::Metrics { source, target, mapped, anchors, gt, samples, seed } => {
             commands::metrics(&source, &target, &mapped, anchors.as_deref(), gt.as_deref(), samples, seed)
         }

@@ -53,9 +53,10 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
     let nf = lx.u64("face count")?;
     let _ne = lx.u64("edge count")?;
     check_limits(opts, nv, nf)?;
-    // Smallest possible vertex: "0 0 0\n" (6 bytes); face: "3 0 0 0\n" (8 bytes).
+    // Smallest possible vertex: "0 0 0\n" (6 bytes); face: "3 0 1 2" plus a separator
+    // (7 bytes with the separator counted once); the last line may lack its newline.
     let per_v = 6 + if h.normal { 6 } else { 0 } + if h.color { 6 } else { 0 } + if h.st { 4 } else { 0 };
-    let need = nv.saturating_mul(per_v).saturating_add(nf.saturating_mul(8));
+    let need = nv.saturating_mul(per_v).saturating_add(nf.saturating_mul(7)).saturating_sub(1);
     if need > lx.remaining() as u64 {
         return Err(InputError::LyingCount {
             format: "OFF",

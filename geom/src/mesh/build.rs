@@ -275,9 +275,8 @@ fn orient(nv: usize, tris: &mut [[u32; 3]]) -> Result<usize> {
     let mut need_fix = false;
     for h in 0..(tris.len() * 3) as u32 {
         edge_mates(&st, tris, h, &mut mates);
-        if mates.len() > 1 {
-            let (a, b) = (tail(tris, h), head(tris, h));
-            // Two faces with the same three vertices are duplicates, not a fan.
+        if !mates.is_empty() {
+            // Two faces with the same three vertices are duplicates, not neighbours.
             let f = (h / 3) as usize;
             let mut key = tris[f];
             key.sort_unstable();
@@ -289,6 +288,9 @@ fn orient(nv: usize, tris: &mut [[u32; 3]]) -> Result<usize> {
                     return Err(InputError::DuplicateFace { face: f.max(o), other: f.min(o) }.into());
                 }
             }
+        }
+        if mates.len() > 1 {
+            let (a, b) = (tail(tris, h), head(tris, h));
             return Err(InputError::NonManifoldEdge { a: a as usize, b: b as usize, count: mates.len() + 1 }.into());
         }
         if mates.len() == 1 && head(tris, mates[0]) == head(tris, h) {

@@ -1,5 +1,5 @@
 //! Sparse linear algebra for mesh Laplacians: edge weights (uniform, cotangent, mean value),
-//! triplet assembly with `sprs`, and fixed-boundary solvers on `faer`'s sparse Cholesky / LU
+//! CSC storage and products with `sprs`, and fixed-boundary solvers on `faer`'s sparse Cholesky / LU
 //! with the symbolic factorization computed once and reused for every numeric factorization.
 
 mod solver;

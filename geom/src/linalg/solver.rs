@@ -14,7 +14,6 @@ use crate::tol;
 use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Mat, Side, linalg::solvers::Solve};
-use sprs::{CsMat, TriMat};
 
 /// Pattern and symbolic factorizations of a fixed-boundary Laplacian system.
 pub struct FixedBoundarySystem {
@@ -80,21 +79,25 @@ impl FixedBoundarySystem {
             })
             .collect();
         let n = free.len();
-        // Pattern: diagonal plus free-free pairs, both directions, via triplets (duplicates merge).
-        let mut tri = TriMat::<f64>::with_capacity((n, n), n + 2 * nh);
-        for i in 0..n {
-            tri.add_triplet(i, i, 1.0);
-        }
-        for &(a, b) in &ends {
-            let (fa, fb) = (free_index[a as usize], free_index[b as usize]);
-            if fa != u32::MAX && fb != u32::MAX {
-                tri.add_triplet(fa as usize, fb as usize, 1.0);
-                tri.add_triplet(fb as usize, fa as usize, 1.0);
+        // Pattern of L_FF, column by column from the one-rings (sorted rows, diagonal included).
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::with_capacity(n + 2 * nh);
+        col_ptr.push(0usize);
+        let mut ring: Vec<usize> = Vec::with_capacity(32);
+        for (c, &v) in free.iter().enumerate() {
+            ring.clear();
+            ring.push(c);
+            for w in mesh.vertex_neighbors(v) {
+                let fw = free_index[w.idx()];
+                if fw != u32::MAX {
+                    ring.push(fw as usize);
+                }
             }
+            ring.sort_unstable();
+            ring.dedup();
+            row_idx.extend_from_slice(&ring);
+            col_ptr.push(row_idx.len());
         }
-        let csc: CsMat<f64> = tri.to_csc();
-        let col_ptr = csc.indptr().raw_storage().to_vec();
-        let row_idx = csc.indices().to_vec();
         let find = |r: usize, c: usize| -> usize {
             let s = &row_idx[col_ptr[c]..col_ptr[c + 1]];
             s.binary_search(&r).map_or(NO, |k| col_ptr[c] + k)
@@ -231,23 +234,18 @@ impl FixedBoundaryFactor<'_> {
             (_, Some(f)) => f.solve_in_place(rhs.as_mut()),
             _ => return Err(Error::Internal("no factorization".into())),
         }
-        // Residual: || A x - b || / max(|| b ||, tiny), per column.
-        let mut ax = Mat::<f64>::zeros(n, K);
-        for c in 0..n {
-            for p in sys.col_ptr[c]..sys.col_ptr[c + 1] {
-                let r = sys.row_idx[p];
-                for k in 0..K {
-                    ax[(r, k)] += self.values[p] * rhs[(c, k)];
-                }
-            }
-        }
+        // Residual || A x - b || / || b || per column, with the sparse product done by sprs.
+        let a = sprs::CsMatView::try_new_csc((n, n), &sys.col_ptr[..], &sys.row_idx[..], &self.values[..])
+            .map_err(|(_, _, _, e)| Error::Internal(format!("Laplacian pattern: {e}")))?;
         for k in 0..K {
-            let mut num = 0.0;
-            let mut den = 0.0;
+            let x: Vec<f64> = (0..n).map(|i| rhs[(i, k)]).collect();
+            let mut axk = vec![0.0; n];
+            sprs::prod::mul_acc_mat_vec_csc(a.view(), &x[..], &mut axk[..]);
+            let (mut num, mut den) = (0.0, 0.0);
             for i in 0..n {
-                let d = ax[(i, k)] - b[(i, k)];
-                num += d * d;
-                den += b[(i, k)] * b[(i, k)];
+                let bi = b[(i, k)];
+                num += (axk[i] - bi) * (axk[i] - bi);
+                den += bi * bi;
             }
             let rel = num.sqrt() / den.sqrt().max(tol::TINY);
             if !rel.is_finite() || (den > 0.0 && rel > tol::SOLVE_RESIDUAL_REL) {

@@ -182,7 +182,17 @@ impl Mesh {
         };
         let positions: Vec<P3> = positions.into_iter().map(|p| P3::new(p[0], p[1], p[2])).collect();
         let nv = positions.len();
-        let n_flipped = orient(nv, &mut tris)?;
+        let mut st = star(nv, &tris);
+        let mut n_flipped = 0;
+        let twin = match twins(&st, &tris)? {
+            Some(t) => t,
+            None => {
+                // Some edge is used twice in one direction: repair the orientation, then link.
+                n_flipped = orient(&st, &mut tris)?;
+                st = star(nv, &tris);
+                twins(&st, &tris)?.ok_or_else(|| crate::Error::Internal("orientation repair left a conflict".into()))?
+            }
+        };
         if n_flipped > 0 {
             warnings.push(Warning::new(
                 "reoriented",
@@ -199,7 +209,7 @@ impl Mesh {
         if n_zero > 0 {
             warnings.push(Warning::new("zero_area_faces", format!("{n_zero} faces have zero area")));
         }
-        let mesh = link(positions, tris, attributes)?;
+        let mesh = link(positions, tris, &st, twin, attributes)?;
         Ok((mesh, warnings))
     }
 
@@ -218,6 +228,8 @@ impl Mesh {
 struct Star {
     off: Vec<u32>,
     he: Vec<u32>,
+    /// Head vertex of `he[k]`, cached so scans stay in contiguous memory.
+    head: Vec<u32>,
 }
 
 fn star(nv: usize, tris: &[[u32; 3]]) -> Star {
@@ -232,14 +244,16 @@ fn star(nv: usize, tris: &[[u32; 3]]) -> Star {
     }
     let mut fill = off.clone();
     let mut he = vec![0u32; tris.len() * 3];
+    let mut hd = vec![0u32; tris.len() * 3];
     for (f, t) in tris.iter().enumerate() {
         for k in 0..3 {
             let v = t[k] as usize;
             he[fill[v] as usize] = (3 * f + k) as u32;
+            hd[fill[v] as usize] = t[(k + 1) % 3];
             fill[v] += 1;
         }
     }
-    Star { off, he }
+    Star { off, he, head: hd }
 }
 
 #[inline]
@@ -255,26 +269,27 @@ fn head(tris: &[[u32; 3]], h: u32) -> u32 {
 fn edge_mates(star: &Star, tris: &[[u32; 3]], h: u32, out: &mut Vec<u32>) {
     out.clear();
     let (a, b) = (tail(tris, h), head(tris, h));
-    for &g in &star.he[star.off[a as usize] as usize..star.off[a as usize + 1] as usize] {
-        if g != h && head(tris, g) == b {
-            out.push(g);
+    let (sa, ea) = (star.off[a as usize] as usize, star.off[a as usize + 1] as usize);
+    for k in sa..ea {
+        if star.head[k] == b && star.he[k] != h {
+            out.push(star.he[k]);
         }
     }
-    for &g in &star.he[star.off[b as usize] as usize..star.off[b as usize + 1] as usize] {
-        if head(tris, g) == a {
-            out.push(g);
+    let (sb, eb) = (star.off[b as usize] as usize, star.off[b as usize + 1] as usize);
+    for k in sb..eb {
+        if star.head[k] == a {
+            out.push(star.he[k]);
         }
     }
 }
 
 /// Checks edge manifoldness and duplicates, then makes the orientation consistent by a
 /// breadth-first walk over faces. Returns the number of faces flipped.
-fn orient(nv: usize, tris: &mut [[u32; 3]]) -> Result<usize> {
-    let st = star(nv, tris);
+fn orient(st: &Star, tris: &mut [[u32; 3]]) -> Result<usize> {
     let mut mates = Vec::new();
     let mut need_fix = false;
     for h in 0..(tris.len() * 3) as u32 {
-        edge_mates(&st, tris, h, &mut mates);
+        edge_mates(st, tris, h, &mut mates);
         if !mates.is_empty() {
             // Two faces with the same three vertices are duplicates, not neighbours.
             let f = (h / 3) as usize;
@@ -313,7 +328,7 @@ fn orient(nv: usize, tris: &mut [[u32; 3]]) -> Result<usize> {
         while let Some(f) = queue.pop_front() {
             for k in 0..3 {
                 let h = (3 * f + k) as u32;
-                edge_mates(&st, tris, h, &mut mates);
+                edge_mates(st, tris, h, &mut mates);
                 if let Some(&g) = mates.first() {
                     let o = (g / 3) as usize;
                     let same_dir = head(tris, g) == head(tris, h);
@@ -345,36 +360,66 @@ fn orient(nv: usize, tris: &mut [[u32; 3]]) -> Result<usize> {
     Ok(n)
 }
 
-/// Links twins, numbers edges, picks outgoing half-edges and checks vertex manifoldness.
-fn link(positions: Vec<P3>, tris: Vec<[u32; 3]>, attributes: VertexAttributes) -> Result<Mesh> {
-    let nv = positions.len();
+/// Pairs every half-edge with its opposite in one pass. `Ok(None)` when an edge is used twice
+/// in the same direction (orientation to repair); errors for non-manifold edges and faces that
+/// duplicate a neighbour with the opposite orientation.
+fn twins(st: &Star, tris: &[[u32; 3]]) -> Result<Option<Vec<HalfedgeId>>> {
     let nh = tris.len() * 3;
-    let st = star(nv, &tris);
     let mut twin = vec![HalfedgeId::INVALID; nh];
-    let mut edge_of = vec![EdgeId::INVALID; nh];
-    let mut edge_he = Vec::with_capacity(nh / 2 + 1);
     for h in 0..nh as u32 {
-        if edge_of[h as usize].is_valid() {
+        let (a, b) = (tail(tris, h), head(tris, h));
+        let (sa, ea) = (st.off[a as usize] as usize, st.off[a as usize + 1] as usize);
+        for k in sa..ea {
+            if st.head[k] == b && st.he[k] != h {
+                return Ok(None);
+            }
+        }
+        if twin[h as usize].is_valid() {
             continue;
         }
-        let (a, b) = (tail(&tris, h), head(&tris, h));
-        let e = EdgeId(edge_he.len() as u32);
-        edge_of[h as usize] = e;
-        let mut t = None;
-        for &g in &st.he[st.off[b as usize] as usize..st.off[b as usize + 1] as usize] {
-            if head(&tris, g) == a {
-                t = Some(g);
-                break;
+        let (sb, eb) = (st.off[b as usize] as usize, st.off[b as usize + 1] as usize);
+        let mut found = None;
+        let mut count = 1;
+        for k in sb..eb {
+            if st.head[k] == a {
+                count += 1;
+                found = Some(st.he[k]);
             }
         }
-        match t {
-            Some(g) => {
-                twin[h as usize] = HalfedgeId(g);
-                twin[g as usize] = HalfedgeId(h);
-                edge_of[g as usize] = e;
-                edge_he.push(HalfedgeId(h));
+        if count > 2 {
+            return Err(InputError::NonManifoldEdge { a: a as usize, b: b as usize, count }.into());
+        }
+        if let Some(g) = found {
+            // Same third vertex on both sides: the two faces are one face twice.
+            let third_h = tail(tris, HalfedgeId(h).prev().0);
+            let third_g = tail(tris, HalfedgeId(g).prev().0);
+            if third_h == third_g {
+                let (f, o) = ((h / 3) as usize, (g / 3) as usize);
+                return Err(InputError::DuplicateFace { face: f.max(o), other: f.min(o) }.into());
             }
-            None => edge_he.push(HalfedgeId(h)),
+            twin[h as usize] = HalfedgeId(g);
+            twin[g as usize] = HalfedgeId(h);
+        }
+    }
+    Ok(Some(twin))
+}
+
+/// Numbers edges, picks outgoing half-edges and checks vertex manifoldness.
+fn link(positions: Vec<P3>, tris: Vec<[u32; 3]>, st: &Star, twin: Vec<HalfedgeId>, attributes: VertexAttributes) -> Result<Mesh> {
+    let nv = positions.len();
+    let nh = tris.len() * 3;
+    let mut edge_of = vec![EdgeId::INVALID; nh];
+    let mut edge_he = Vec::with_capacity(nh / 2 + 1);
+    for h in 0..nh {
+        if edge_of[h].is_valid() {
+            continue;
+        }
+        let e = EdgeId(edge_he.len() as u32);
+        edge_of[h] = e;
+        edge_he.push(HalfedgeId(h as u32));
+        let t = twin[h];
+        if t.is_valid() {
+            edge_of[t.idx()] = e;
         }
     }
     let mut vertex_he = vec![HalfedgeId::INVALID; nv];

@@ -55,23 +55,27 @@ fn read_anchors(path: &Path) -> Result<Vec<(VertexId, VertexId)>> {
     struct AnchorFile {
         anchors: Vec<(u32, u32)>,
     }
-    let text = std::fs::read_to_string(path).map_err(|e| InputError::Invalid(format!("cannot read {}: {e}", path.display())))?;
-    let f: AnchorFile = serde_json::from_str(&text)
-        .map_err(|e| InputError::Invalid(format!("{}: expected {{\"anchors\": [[s, t], ...]}}: {e}", path.display())))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::Invalid(format!("cannot read {}: {e}", path.display())))?;
+    let f: AnchorFile = serde_json::from_str(&text).map_err(|e| {
+        InputError::Invalid(format!("{}: expected {{\"anchors\": [[s, t], ...]}}: {e}", path.display()))
+    })?;
     Ok(f.anchors.into_iter().map(|(s, t)| (VertexId(s), VertexId(t))).collect())
 }
 
 /// Reads one 0-based target vertex per line.
 fn read_gt(path: &Path) -> Result<Vec<VertexId>> {
-    let text = std::fs::read_to_string(path).map_err(|e| InputError::Invalid(format!("cannot read {}: {e}", path.display())))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::Invalid(format!("cannot read {}: {e}", path.display())))?;
     text.lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
         .map(|(i, l)| {
             let t = l.split_whitespace().next().unwrap_or("");
-            t.parse::<u32>()
-                .map(VertexId)
-                .map_err(|_| InputError::Invalid(format!("{} line {}: expected a vertex index, found {t:?}", path.display(), i + 1)).into())
+            t.parse::<u32>().map(VertexId).map_err(|_| {
+                InputError::Invalid(format!("{} line {}: expected a vertex index, found {t:?}", path.display(), i + 1))
+                    .into()
+            })
         })
         .collect()
 }
@@ -91,7 +95,10 @@ pub fn metrics(
     let m = read(mapped)?.mesh;
     let anchors = anchors.map(read_anchors).transpose()?;
     let gt = gt.map(read_gt).transpose()?;
-    let opts = geom::metrics::MetricsOptions { samples, seeds: (seed.wrapping_mul(2).wrapping_add(1), seed.wrapping_mul(2).wrapping_add(2)) };
+    let opts = geom::metrics::MetricsOptions {
+        samples,
+        seeds: (seed.wrapping_mul(2).wrapping_add(1), seed.wrapping_mul(2).wrapping_add(2)),
+    };
     let r = geom::metrics::evaluate_map(&s, &t, &m, anchors.as_deref(), gt.as_deref(), &opts)?;
     serde_json::to_string_pretty(&r).map_err(|e| Error::Internal(e.to_string()))
 }

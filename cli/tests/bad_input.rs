@@ -88,7 +88,8 @@ fn missing_file_and_bad_arguments_exit_2() {
 #[test]
 fn valid_polygons_are_triangulated_with_a_warning() {
     let d = tempdir("poly");
-    let p = write(&d, "mixed.off", b"OFF\n6 3 0\n0 0 0\n1 0 0\n2 0 0\n2 1 0\n1 1 0\n0 1 0\n3 0 1 4\n4 1 2 3 4\n3 0 4 5\n");
+    let p =
+        write(&d, "mixed.off", b"OFF\n6 3 0\n0 0 0\n1 0 0\n2 0 0\n2 1 0\n1 1 0\n0 1 0\n3 0 1 4\n4 1 2 3 4\n3 0 4 5\n");
     let j = stdout_json(&surfmap(&["inspect", p.to_str().unwrap()]));
     assert_eq!(j["faces"], 4);
     assert_eq!(j["boundary_loops"], 1);

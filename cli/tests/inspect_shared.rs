@@ -14,8 +14,12 @@ fn inspect_matches_readme_table_for_every_mesh() {
             continue;
         }
         let Ok(v) = cells[2].parse::<u64>() else { continue };
-        let (f, e, g, b): (u64, u64, i64, u64) =
-            (cells[3].parse().unwrap(), cells[4].parse().unwrap(), cells[5].parse().unwrap(), cells[6].parse().unwrap());
+        let (f, e, g, b): (u64, u64, i64, u64) = (
+            cells[3].parse().unwrap(),
+            cells[4].parse().unwrap(),
+            cells[5].parse().unwrap(),
+            cells[6].parse().unwrap(),
+        );
         let path = mesh(cells[1]);
         let out = surfmap(&["inspect", path.to_str().unwrap()]);
         let j = stdout_json(&out);

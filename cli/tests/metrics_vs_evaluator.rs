@@ -34,13 +34,29 @@ fn check(source: &str, target: &str, mapped: &str, expected: &[(&str, f64)]) {
 fn identity_map() {
     let c = mesh("cow.off");
     let c = c.to_str().unwrap();
-    check(c, c, c, &[
-        ("vertices", 2762.0), ("faces", 5520.0), ("off_surface_max", 0.0), ("off_surface_mean", 0.0),
-        ("flipped_faces", 0.0), ("area_ratio", 1.0), ("l2_stretch", 1.0), ("linf_stretch", 1.0000000000000004),
-        ("angle_distortion", 0.0), ("degenerate_faces", 0.0), ("hausdorff", 0.0013052131724197672),
-        ("rms", 9.68564311190436e-06), ("psnr_db", 100.2774307499484), ("anchor_error_max", 0.0),
-        ("gt_error_mean", 0.0), ("gt_error_max", 0.0),
-    ]);
+    check(
+        c,
+        c,
+        c,
+        &[
+            ("vertices", 2762.0),
+            ("faces", 5520.0),
+            ("off_surface_max", 0.0),
+            ("off_surface_mean", 0.0),
+            ("flipped_faces", 0.0),
+            ("area_ratio", 1.0),
+            ("l2_stretch", 1.0),
+            ("linf_stretch", 1.0000000000000004),
+            ("angle_distortion", 0.0),
+            ("degenerate_faces", 0.0),
+            ("hausdorff", 0.0013052131724197672),
+            ("rms", 9.68564311190436e-06),
+            ("psnr_db", 100.2774307499484),
+            ("anchor_error_max", 0.0),
+            ("gt_error_mean", 0.0),
+            ("gt_error_max", 0.0),
+        ],
+    );
 }
 
 #[test]
@@ -48,13 +64,29 @@ fn affine_stretch() {
     let c = mesh("cow.off");
     let a = fixture("cow_affine.off");
     let a = a.to_str().unwrap();
-    check(c.to_str().unwrap(), a, a, &[
-        ("vertices", 2762.0), ("faces", 5520.0), ("off_surface_max", 0.0), ("off_surface_mean", 0.0),
-        ("flipped_faces", 0.0), ("area_ratio", 1.0), ("l2_stretch", 1.0686889139977285),
-        ("linf_stretch", 1.3692344726085246), ("angle_distortion", 0.3037685238121739), ("degenerate_faces", 0.0),
-        ("hausdorff", 0.0010771065329273134), ("rms", 6.3091660235041334e-06), ("psnr_db", 104.00056088271558),
-        ("anchor_error_max", 0.0), ("gt_error_mean", 0.0), ("gt_error_max", 0.0),
-    ]);
+    check(
+        c.to_str().unwrap(),
+        a,
+        a,
+        &[
+            ("vertices", 2762.0),
+            ("faces", 5520.0),
+            ("off_surface_max", 0.0),
+            ("off_surface_mean", 0.0),
+            ("flipped_faces", 0.0),
+            ("area_ratio", 1.0),
+            ("l2_stretch", 1.0686889139977285),
+            ("linf_stretch", 1.3692344726085246),
+            ("angle_distortion", 0.3037685238121739),
+            ("degenerate_faces", 0.0),
+            ("hausdorff", 0.0010771065329273134),
+            ("rms", 6.3091660235041334e-06),
+            ("psnr_db", 104.00056088271558),
+            ("anchor_error_max", 0.0),
+            ("gt_error_mean", 0.0),
+            ("gt_error_max", 0.0),
+        ],
+    );
 }
 
 #[test]
@@ -62,12 +94,27 @@ fn locally_folded_map() {
     let c = mesh("cow.off");
     let c = c.to_str().unwrap();
     let f = fixture("cow_fold.off");
-    check(c, c, f.to_str().unwrap(), &[
-        ("vertices", 2762.0), ("faces", 5520.0), ("off_surface_max", 0.0), ("off_surface_mean", 0.0),
-        ("flipped_faces", 2.0), ("area_ratio", 1.0003774472200393), ("l2_stretch", 1.001209363453283),
-        ("linf_stretch", 6.982522104462847), ("angle_distortion", 0.003411079462413813), ("degenerate_faces", 0.0),
-        ("hausdorff", 0.004550622959473937), ("rms", 4.008019478320851e-05), ("psnr_db", 87.94140353070689),
-        ("anchor_error_max", 0.026928458979658707), ("gt_error_mean", 1.1873204540058078e-05),
-        ("gt_error_max", 0.03279379093964041),
-    ]);
+    check(
+        c,
+        c,
+        f.to_str().unwrap(),
+        &[
+            ("vertices", 2762.0),
+            ("faces", 5520.0),
+            ("off_surface_max", 0.0),
+            ("off_surface_mean", 0.0),
+            ("flipped_faces", 2.0),
+            ("area_ratio", 1.0003774472200393),
+            ("l2_stretch", 1.001209363453283),
+            ("linf_stretch", 6.982522104462847),
+            ("angle_distortion", 0.003411079462413813),
+            ("degenerate_faces", 0.0),
+            ("hausdorff", 0.004550622959473937),
+            ("rms", 4.008019478320851e-05),
+            ("psnr_db", 87.94140353070689),
+            ("anchor_error_max", 0.026928458979658707),
+            ("gt_error_mean", 1.1873204540058078e-05),
+            ("gt_error_max", 0.03279379093964041),
+        ],
+    );
 }

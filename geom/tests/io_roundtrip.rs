@@ -101,7 +101,8 @@ element face 2\nproperty uchar flags\nproperty list uchar uint vertex_indices\ne
 
 #[test]
 fn stl_ascii_and_binary_weld_identical_vertices() {
-    let ascii = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\nendfacet\n\
+    let ascii =
+        b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\nendloop\nendfacet\n\
 facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
     let r = read(ascii);
     assert_eq!(r.format, Format::Stl);

@@ -31,7 +31,8 @@ fn disk_parameterizations_of_real_disks_are_injective() {
         }
         // Cotangent (harmonic) weights: the solve is exact; flips are possible on obtuse meshes
         // and are reported, not hidden.
-        let r = parameterize_disk(&m, &DiskParamOptions { weights: Weights::Cotan, boundary: BoundaryShape::Circle }).unwrap();
+        let r = parameterize_disk(&m, &DiskParamOptions { weights: Weights::Cotan, boundary: BoundaryShape::Circle })
+            .unwrap();
         assert!(r.residual < 1e-10, "{name} cotan residual {}", r.residual);
         assert!(r.injectivity.flipped * 100 < m.n_faces(), "{name}: {:?}", r.injectivity);
     }
@@ -94,7 +95,10 @@ fn edge_node_paths_are_shorter_than_vertex_paths_and_stay_in_the_region() {
     // Restricted to the two Voronoi cells of the endpoints, the path stays inside them.
     let r = face_voronoi(&m, &pts, &Default::default()).unwrap();
     let mask: Vec<bool> = r.label.iter().map(|&l| l == 0 || l == 1).collect();
-    if let Some(p) = g.shortest_path(g.vertex_node(pts[0]), g.vertex_node(pts[1]), &PathOptions { faces: Some(&mask), blocked: None }).unwrap() {
+    if let Some(p) = g
+        .shortest_path(g.vertex_node(pts[0]), g.vertex_node(pts[1]), &PathOptions { faces: Some(&mask), blocked: None })
+        .unwrap()
+    {
         for q in &p.points {
             let (f, _) = q.in_face(&m);
             let inside = mask[f.idx()] || m.face_neighbors(f).any(|g| mask[g.idx()]);

@@ -107,10 +107,9 @@ impl<'m> EdgeNodeGraph<'m> {
         let mut pos = mesh.positions().to_vec();
         pos.reserve(next as usize - nv);
         let mut node_edge = Vec::with_capacity(next as usize - nv);
-        for e in 0..ne {
+        for (e, &k) in count.iter().enumerate() {
             let h = mesh.edge_halfedge(EdgeId::from_idx(e));
             let (p, q) = (mesh.position(mesh.tail(h)), mesh.position(mesh.head(h)));
-            let k = count[e];
             for i in 0..k {
                 let t = f64::from(i + 1) / f64::from(k + 1);
                 pos.push(P3::from(p.coords * (1.0 - t) + q.coords * t));
@@ -238,7 +237,9 @@ impl<'m> EdgeNodeGraph<'m> {
     pub fn shortest_path(&self, from: NodeId, to: NodeId, opts: &PathOptions) -> Result<Option<SurfacePath>> {
         let nn = self.n_nodes();
         if from.0 as usize >= nn || to.0 as usize >= nn {
-            return Err(InputError::OutOfRange { what: "path node", index: from.0.max(to.0) as usize, count: nn }.into());
+            return Err(
+                InputError::OutOfRange { what: "path node", index: from.0.max(to.0) as usize, count: nn }.into()
+            );
         }
         if opts.faces.is_some_and(|m| m.len() != self.mesh.n_faces()) {
             return Err(InputError::Invalid("face mask size differs from the face count".into()).into());
@@ -327,11 +328,16 @@ impl<'m> EdgeNodeGraph<'m> {
 ///
 /// # Errors
 /// As [`EdgeNodeGraph::shortest_path`].
-pub fn shortest_path(mesh: &Mesh, from: VertexId, to: VertexId, graph_opts: &EdgeNodeOptions, opts: &PathOptions) -> Result<Option<SurfacePath>> {
+pub fn shortest_path(
+    mesh: &Mesh,
+    from: VertexId,
+    to: VertexId,
+    graph_opts: &EdgeNodeOptions,
+    opts: &PathOptions,
+) -> Result<Option<SurfacePath>> {
     let g = EdgeNodeGraph::new(mesh, graph_opts);
     g.shortest_path(g.vertex_node(from), g.vertex_node(to), opts)
 }
-
 
 #[cfg(test)]
 mod tests {
@@ -380,7 +386,10 @@ mod tests {
         for n in &free.nodes[1..free.nodes.len() - 1] {
             blocked[n.0 as usize] = true;
         }
-        let detour = eg.shortest_path(NodeId(0), NodeId(4), &PathOptions { faces: None, blocked: Some(&blocked) }).unwrap().unwrap();
+        let detour = eg
+            .shortest_path(NodeId(0), NodeId(4), &PathOptions { faces: None, blocked: Some(&blocked) })
+            .unwrap()
+            .unwrap();
         assert!(detour.length > free.length);
         assert!(detour.nodes[1..detour.nodes.len() - 1].iter().all(|n| !blocked[n.0 as usize]));
     }

@@ -35,10 +35,10 @@ fn centroid(mesh: &Mesh, f: FaceId) -> P3 {
 /// `InputError::OutOfRange` for a source outside the mesh; `Invalid` for a bad face mask.
 pub fn face_voronoi(mesh: &Mesh, sources: &[VertexId], opts: &FaceVoronoiOptions) -> Result<FaceVoronoiResult> {
     let nf = mesh.n_faces();
-    if let Some(m) = opts.faces {
-        if m.len() != nf {
-            return Err(InputError::Invalid(format!("face mask has {} entries for {nf} faces", m.len())).into());
-        }
+    if let Some(m) = opts.faces
+        && m.len() != nf
+    {
+        return Err(InputError::Invalid(format!("face mask has {} entries for {nf} faces", m.len())).into());
     }
     let allowed = |f: FaceId| opts.faces.is_none_or(|m| m[f.idx()]);
     let cent: Vec<P3> = (0..nf).map(|f| centroid(mesh, FaceId::from_idx(f))).collect();
@@ -48,7 +48,9 @@ pub fn face_voronoi(mesh: &Mesh, sources: &[VertexId], opts: &FaceVoronoiOptions
     let mut heap = MinHeap::with_capacity(nf / 4 + 16);
     for (i, &s) in sources.iter().enumerate() {
         if s.idx() >= mesh.n_vertices() {
-            return Err(InputError::OutOfRange { what: "source vertex", index: s.idx(), count: mesh.n_vertices() }.into());
+            return Err(
+                InputError::OutOfRange { what: "source vertex", index: s.idx(), count: mesh.n_vertices() }.into()
+            );
         }
         let ps = mesh.position(s);
         for f in mesh.vertex_faces(s) {

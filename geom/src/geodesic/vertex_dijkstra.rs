@@ -48,12 +48,18 @@ impl VertexDijkstraResult {
 /// # Errors
 /// `InputError::OutOfRange` for a source outside the mesh, `Invalid` for a face mask of the
 /// wrong length.
-pub fn vertex_dijkstra(mesh: &Mesh, sources: &[(VertexId, f64)], opts: &VertexDijkstraOptions) -> Result<VertexDijkstraResult> {
+pub fn vertex_dijkstra(
+    mesh: &Mesh,
+    sources: &[(VertexId, f64)],
+    opts: &VertexDijkstraOptions,
+) -> Result<VertexDijkstraResult> {
     let nv = mesh.n_vertices();
-    if let Some(m) = opts.faces {
-        if m.len() != mesh.n_faces() {
-            return Err(InputError::Invalid(format!("face mask has {} entries for {} faces", m.len(), mesh.n_faces())).into());
-        }
+    if let Some(m) = opts.faces
+        && m.len() != mesh.n_faces()
+    {
+        return Err(
+            InputError::Invalid(format!("face mask has {} entries for {} faces", m.len(), mesh.n_faces())).into()
+        );
     }
     let mut dist = vec![f64::INFINITY; nv];
     let mut pred = vec![VertexId::INVALID; nv];
@@ -151,7 +157,12 @@ mod tests {
         let g = shapes::grid(4);
         // Only the faces of the bottom row of squares.
         let mask: Vec<bool> = (0..g.n_faces()).map(|f| f < 8).collect();
-        let r = vertex_dijkstra(&g, &[(VertexId(0), 0.0)], &VertexDijkstraOptions { faces: Some(&mask), ..Default::default() }).unwrap();
+        let r = vertex_dijkstra(
+            &g,
+            &[(VertexId(0), 0.0)],
+            &VertexDijkstraOptions { faces: Some(&mask), ..Default::default() },
+        )
+        .unwrap();
         assert!(r.dist[24].is_infinite());
         assert!(r.dist[9].is_finite());
     }

@@ -155,8 +155,9 @@ pub fn write(mesh: &Mesh, format: Format) -> Vec<u8> {
 /// # Errors
 /// `InputError::UnknownFormat` for an unknown extension; `Error::Internal` on I/O failure.
 pub fn write_path(mesh: &Mesh, path: &Path) -> Result<()> {
-    let fmt = Format::from_extension(path)
-        .ok_or_else(|| InputError::UnknownFormat(format!("cannot tell the format of {} from its extension", path.display())))?;
+    let fmt = Format::from_extension(path).ok_or_else(|| {
+        InputError::UnknownFormat(format!("cannot tell the format of {} from its extension", path.display()))
+    })?;
     write_bytes(path, &write(mesh, fmt))
 }
 

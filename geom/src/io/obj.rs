@@ -19,8 +19,12 @@ pub(crate) fn sniff(b: &[u8]) -> bool {
     }
     head.split(|&c| c == b'\n').any(|l| {
         let l = l.trim_ascii_start();
-        l.starts_with(b"v ") || l.starts_with(b"f ") || l.starts_with(b"vn ") || l.starts_with(b"vt ")
-            || l.starts_with(b"v\t") || l.starts_with(b"f\t")
+        l.starts_with(b"v ")
+            || l.starts_with(b"f ")
+            || l.starts_with(b"vn ")
+            || l.starts_with(b"vt ")
+            || l.starts_with(b"v\t")
+            || l.starts_with(b"f\t")
     })
 }
 
@@ -125,7 +129,20 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
                 }
             }
             _ => {
-                let known = [&b"o"[..], b"g", b"s", b"usemtl", b"mtllib", b"l", b"p", b"vp", b"cstype", b"deg", b"curv", b"surf"];
+                let known = [
+                    &b"o"[..],
+                    b"g",
+                    b"s",
+                    b"usemtl",
+                    b"mtllib",
+                    b"l",
+                    b"p",
+                    b"vp",
+                    b"cstype",
+                    b"deg",
+                    b"curv",
+                    b"surf",
+                ];
                 if !known.contains(&kw) {
                     ignored_lines += 1;
                 }
@@ -140,7 +157,8 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
         return Err(InputError::Empty("OBJ file has no vertices or faces".into()).into());
     }
     if ignored_lines > 0 {
-        warnings.push(Warning::new("unknown_statements", format!("{ignored_lines} unknown OBJ statements were ignored")));
+        warnings
+            .push(Warning::new("unknown_statements", format!("{ignored_lines} unknown OBJ statements were ignored")));
     }
     let nv = positions.len();
     let mut raw = RawMesh { positions, indices, sizes: (!all_tri).then_some(sizes), warnings, ..Default::default() };
@@ -151,7 +169,8 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
     raw.attributes.uvs = per_vertex(&raw, &corner_vt, &vts, "texture coordinates");
     raw.attributes.normals = per_vertex(&raw, &corner_vn, &vns, "normals");
     if !vts.is_empty() && raw.attributes.uvs.is_none() {
-        raw.warnings.push(Warning::new("uv_seams", "texture coordinates differ per corner (seams); not kept per vertex"));
+        raw.warnings
+            .push(Warning::new("uv_seams", "texture coordinates differ per corner (seams); not kept per vertex"));
     }
     if !vns.is_empty() && raw.attributes.normals.is_none() {
         raw.warnings.push(Warning::new("normal_seams", "normals differ per corner; not kept per vertex"));
@@ -177,7 +196,7 @@ fn per_vertex<T: Clone>(raw: &RawMesh, corner: &[u32], values: &[T], _what: &str
             return None;
         }
     }
-    if of.iter().any(|&a| a == NONE) {
+    if of.contains(&NONE) {
         // Unreferenced vertices: give them the first value; they are removed later anyway.
         for a in &mut of {
             if *a == NONE {

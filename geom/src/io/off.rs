@@ -101,7 +101,8 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
                 return Err(lx.err(format!("expected 3 or 4 colour components, found {}", rest.len())));
             }
             let is_float = *color_is_float.get_or_insert(any_dot);
-            let conv = |x: f64| if is_float { (x * 255.0).round().clamp(0.0, 255.0) as u8 } else { x.clamp(0.0, 255.0) as u8 };
+            let conv =
+                |x: f64| if is_float { (x * 255.0).round().clamp(0.0, 255.0) as u8 } else { x.clamp(0.0, 255.0) as u8 };
             let a = if rest.len() == 4 { conv(rest[3]) } else { 255 };
             c.push([conv(rest[0]), conv(rest[1]), conv(rest[2]), a]);
         }

@@ -205,7 +205,9 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
     for (name, def) in &header.elements {
         let line = rd.line();
         match name.as_str() {
-            "vertex" => verts = vparser.read_payload_for_element(&mut rd, def, &header).map_err(|e| ply_err(e, line))?,
+            "vertex" => {
+                verts = vparser.read_payload_for_element(&mut rd, def, &header).map_err(|e| ply_err(e, line))?
+            }
             "face" => {
                 if !def.properties.keys().any(|k| is_index_list(k)) {
                     return Err(parse_err("PLY", "header", "face element has no vertex_indices list"));
@@ -263,7 +265,8 @@ pub(crate) fn write(mesh: &Mesh, out: &mut Vec<u8>) {
 /// Binary PLY with extra per-face integer properties (e.g. a patch id), each `(name, values)`.
 pub fn write_with_face_ints(mesh: &Mesh, face_props: &[(&str, &[i32])], out: &mut Vec<u8>) {
     let a = mesh.attributes();
-    let mut h = format!("ply\nformat binary_little_endian 1.0\ncomment surfmap\nelement vertex {}\n", mesh.n_vertices());
+    let mut h =
+        format!("ply\nformat binary_little_endian 1.0\ncomment surfmap\nelement vertex {}\n", mesh.n_vertices());
     h.push_str("property double x\nproperty double y\nproperty double z\n");
     if a.normals.is_some() {
         h.push_str("property double nx\nproperty double ny\nproperty double nz\n");

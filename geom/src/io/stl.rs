@@ -68,7 +68,10 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
     }
     let mut raw = RawMesh { positions, indices, ..Default::default() };
     if dropped > 0 {
-        raw.warnings.push(Warning::new("collapsed_faces", format!("{dropped} STL triangles collapsed after welding and were dropped")));
+        raw.warnings.push(Warning::new(
+            "collapsed_faces",
+            format!("{dropped} STL triangles collapsed after welding and were dropped"),
+        ));
     }
     Ok(raw)
 }
@@ -82,7 +85,10 @@ pub(crate) fn write(mesh: &Mesh, out: &mut Vec<u8>) {
             let p = mesh.position(f[i]);
             stl_io::Vector::new([p.x as f32, p.y as f32, p.z as f32])
         };
-        stl_io::Triangle { normal: stl_io::Vector::new([n.x as f32, n.y as f32, n.z as f32]), vertices: [v(0), v(1), v(2)] }
+        stl_io::Triangle {
+            normal: stl_io::Vector::new([n.x as f32, n.y as f32, n.z as f32]),
+            vertices: [v(0), v(1), v(2)],
+        }
     });
     // Writing to a Vec cannot fail.
     let _ = stl_io::write_stl(out, tris);

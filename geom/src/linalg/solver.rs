@@ -126,7 +126,8 @@ impl FixedBoundarySystem {
             ends,
         };
         let pattern = sys.pattern();
-        let llt = SymbolicLlt::try_new(pattern, Side::Lower).map_err(|e| Error::Numerical(format!("symbolic Cholesky: {e:?}")))?;
+        let llt = SymbolicLlt::try_new(pattern, Side::Lower)
+            .map_err(|e| Error::Numerical(format!("symbolic Cholesky: {e:?}")))?;
         sys.sym_llt = Some(llt);
         Ok(sys)
     }
@@ -152,7 +153,8 @@ impl FixedBoundarySystem {
     pub fn factor(&mut self, mesh: &Mesh, weights: Weights) -> Result<FixedBoundaryFactor<'_>> {
         let w = directed_weights(mesh, weights);
         if !weights.is_symmetric() && self.sym_lu.is_none() {
-            let lu = SymbolicLu::try_new(self.pattern()).map_err(|e| Error::Numerical(format!("symbolic LU: {e:?}")))?;
+            let lu =
+                SymbolicLu::try_new(self.pattern()).map_err(|e| Error::Numerical(format!("symbolic LU: {e:?}")))?;
             self.sym_lu = Some(lu);
         }
         self.factor_weights(&w, weights.is_symmetric())
@@ -200,7 +202,9 @@ impl FixedBoundarySystem {
         } else {
             let sym = match &self.sym_lu {
                 Some(s) => s.clone(),
-                None => SymbolicLu::try_new(self.pattern()).map_err(|e| Error::Numerical(format!("symbolic LU: {e:?}")))?,
+                None => {
+                    SymbolicLu::try_new(self.pattern()).map_err(|e| Error::Numerical(format!("symbolic LU: {e:?}")))?
+                }
             };
             lu = Some(
                 Lu::try_new_with_symbolic(sym, mat)
@@ -249,7 +253,10 @@ impl FixedBoundaryFactor<'_> {
             }
             let rel = num.sqrt() / den.sqrt().max(tol::TINY);
             if !rel.is_finite() || (den > 0.0 && rel > tol::SOLVE_RESIDUAL_REL) {
-                return Err(Error::Numerical(format!("linear solve residual {rel:.3e} exceeds {:.0e}", tol::SOLVE_RESIDUAL_REL)));
+                return Err(Error::Numerical(format!(
+                    "linear solve residual {rel:.3e} exceeds {:.0e}",
+                    tol::SOLVE_RESIDUAL_REL
+                )));
             }
         }
         let mut out = vec![[0.0; K]; sys.n_vertices];

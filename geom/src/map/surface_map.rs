@@ -68,11 +68,19 @@ impl SurfaceMap {
     /// `InputError::Invalid` naming the first bad entry.
     pub fn validate(&self, n_source: usize, target: &Mesh) -> Result<()> {
         if self.face.len() != n_source || self.bary.len() != n_source {
-            return Err(InputError::Invalid(format!("map has {} entries for {n_source} source vertices", self.face.len())).into());
+            return Err(InputError::Invalid(format!(
+                "map has {} entries for {n_source} source vertices",
+                self.face.len()
+            ))
+            .into());
         }
         for (v, (f, b)) in self.face.iter().zip(&self.bary).enumerate() {
             if f.idx() >= target.n_faces() {
-                return Err(InputError::Invalid(format!("vertex {v} maps to face {f}, but the target has {} faces", target.n_faces())).into());
+                return Err(InputError::Invalid(format!(
+                    "vertex {v} maps to face {f}, but the target has {} faces",
+                    target.n_faces()
+                ))
+                .into());
             }
             let s = b[0] + b[1] + b[2];
             if b.iter().any(|x| !x.is_finite() || *x < -1e-9) || (s - 1.0).abs() > 1e-9 {

@@ -100,7 +100,9 @@ impl Mesh {
                 for (f, c) in indices.chunks_exact(3).enumerate() {
                     for &i in c {
                         if i as usize >= nv {
-                            return Err(InputError::IndexOutOfRange { face: f, index: i as i64, vertex_count: nv }.into());
+                            return Err(
+                                InputError::IndexOutOfRange { face: f, index: i as i64, vertex_count: nv }.into()
+                            );
                         }
                     }
                     tris.push([c[0], c[1], c[2]]);
@@ -119,7 +121,9 @@ impl Mesh {
                     }
                     for &i in poly {
                         if i as usize >= nv {
-                            return Err(InputError::IndexOutOfRange { face: f, index: i as i64, vertex_count: nv }.into());
+                            return Err(
+                                InputError::IndexOutOfRange { face: f, index: i as i64, vertex_count: nv }.into()
+                            );
                         }
                     }
                     if k == 3 {
@@ -337,7 +341,9 @@ fn orient(st: &Star, tris: &mut [[u32; 3]]) -> Result<usize> {
                         flip[o] = want;
                         queue.push_back(o);
                     } else if flip[o] != want {
-                        return Err(InputError::NonOrientable { a: tail(tris, h) as usize, b: head(tris, h) as usize }.into());
+                        return Err(
+                            InputError::NonOrientable { a: tail(tris, h) as usize, b: head(tris, h) as usize }.into()
+                        );
                     }
                 }
             }
@@ -405,7 +411,13 @@ fn twins(st: &Star, tris: &[[u32; 3]]) -> Result<Option<Vec<HalfedgeId>>> {
 }
 
 /// Numbers edges, picks outgoing half-edges and checks vertex manifoldness.
-fn link(positions: Vec<P3>, tris: Vec<[u32; 3]>, st: &Star, twin: Vec<HalfedgeId>, attributes: VertexAttributes) -> Result<Mesh> {
+fn link(
+    positions: Vec<P3>,
+    tris: Vec<[u32; 3]>,
+    st: &Star,
+    twin: Vec<HalfedgeId>,
+    attributes: VertexAttributes,
+) -> Result<Mesh> {
     let nv = positions.len();
     let nh = tris.len() * 3;
     let mut edge_of = vec![EdgeId::INVALID; nh];
@@ -423,10 +435,10 @@ fn link(positions: Vec<P3>, tris: Vec<[u32; 3]>, st: &Star, twin: Vec<HalfedgeId
         }
     }
     let mut vertex_he = vec![HalfedgeId::INVALID; nv];
-    for v in 0..nv {
+    for (v, slot) in vertex_he.iter_mut().enumerate() {
         let hs = &st.he[st.off[v] as usize..st.off[v + 1] as usize];
         let start = hs.iter().copied().find(|&h| !twin[h as usize].is_valid()).unwrap_or(hs[0]);
-        vertex_he[v] = HalfedgeId(start);
+        *slot = HalfedgeId(start);
     }
     let mesh = Mesh {
         positions,

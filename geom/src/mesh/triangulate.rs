@@ -22,7 +22,7 @@ pub fn triangulate_polygon(positions: &[[f64; 3]], poly: &[u32], out: &mut Vec<[
         nrm += Vector3::new((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
     }
     let len = nrm.norm();
-    if !(len > 0.0) {
+    if len.is_nan() || len <= 0.0 {
         fan(poly, out);
         return false;
     }

@@ -74,7 +74,12 @@ pub fn distortion(source: &Mesh, mapped: &Mesh) -> Distortion {
         linf = linf.max(s1);
     }
     let wsum = wsum.max(tol::TINY);
-    Distortion { l2_stretch: (l2 / wsum).sqrt(), linf_stretch: linf, angle_distortion: ang / wsum - 2.0, degenerate_faces: degenerate }
+    Distortion {
+        l2_stretch: (l2 / wsum).sqrt(),
+        linf_stretch: linf,
+        angle_distortion: ang / wsum - 2.0,
+        degenerate_faces: degenerate,
+    }
 }
 
 #[cfg(test)]

@@ -19,7 +19,12 @@ pub fn flipped_faces(mapped: &Mesh, target: &Mesh, index: &SurfaceIndex, vertex_
         let fid = FaceId::from_idx(fi);
         let nm = mapped.face_normal_raw(fid);
         let c = centroid(mapped.face_points(fid));
-        let under = [index.query(&c).face, vertex_nearest[f[0].idx()].face, vertex_nearest[f[1].idx()].face, vertex_nearest[f[2].idx()].face];
+        let under = [
+            index.query(&c).face,
+            vertex_nearest[f[0].idx()].face,
+            vertex_nearest[f[1].idx()].face,
+            vertex_nearest[f[2].idx()].face,
+        ];
         if under.iter().all(|g| nm.dot(&tn[g.idx()]) < 0.0) {
             count += 1;
         }

@@ -167,7 +167,15 @@ mod tests {
     #[test]
     fn identity_map_is_perfect() {
         let s = shapes::icosphere(2);
-        let m = evaluate_map(&s, &s, &s, Some(&[(VertexId(0), VertexId(0))]), None, &MetricsOptions { samples: 2000, seeds: (1, 2) }).unwrap();
+        let m = evaluate_map(
+            &s,
+            &s,
+            &s,
+            Some(&[(VertexId(0), VertexId(0))]),
+            None,
+            &MetricsOptions { samples: 2000, seeds: (1, 2) },
+        )
+        .unwrap();
         assert_eq!(m.flipped_faces, 0);
         assert!(m.off_surface_max < 1e-12);
         assert!((m.area_ratio - 1.0).abs() < 1e-12);

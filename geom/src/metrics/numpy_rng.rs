@@ -114,10 +114,12 @@ impl NumpyRng {
         for c in &mut cdf {
             *c /= last;
         }
-        (0..n).map(|_| {
-            let u = self.random();
-            cdf.partition_point(|&c| c <= u).min(weights.len().saturating_sub(1))
-        }).collect()
+        (0..n)
+            .map(|_| {
+                let u = self.random();
+                cdf.partition_point(|&c| c <= u).min(weights.len().saturating_sub(1))
+            })
+            .collect()
     }
 }
 

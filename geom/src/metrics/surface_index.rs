@@ -95,7 +95,8 @@ impl<'m> SurfaceIndex<'m> {
             })
             .collect();
         let tree = ImmutableKdTree::new_from_slice(&cents).map_err(|e| Error::Internal(format!("k-d tree: {e:?}")))?;
-        let k = NonZeroUsize::new(CANDIDATES.min(mesh.n_faces())).ok_or_else(|| Error::Internal("mesh has no faces".into()))?;
+        let k = NonZeroUsize::new(CANDIDATES.min(mesh.n_faces()))
+            .ok_or_else(|| Error::Internal("mesh has no faces".into()))?;
         Ok(Self { mesh, tree, k })
     }
 

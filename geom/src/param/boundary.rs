@@ -103,7 +103,10 @@ pub fn map_boundary_to_polygon(mesh: &Mesh, lp: &[VertexId], shape: &BoundarySha
         }
     };
     if corners.len() != k || corners.windows(2).any(|w| w[0] >= w[1]) || corners.last().is_some_and(|&l| l >= n) {
-        return Err(InputError::Invalid("polygon corners must be increasing loop positions, one per polygon vertex".into()).into());
+        return Err(InputError::Invalid(
+            "polygon corners must be increasing loop positions, one per polygon vertex".into(),
+        )
+        .into());
     }
     let mut uv = vec![[0.0; 2]; n];
     for j in 0..k {

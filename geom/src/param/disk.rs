@@ -62,11 +62,8 @@ mod tests {
 
     fn bumpy_disk() -> Mesh {
         let g = shapes::grid(12);
-        let p: Vec<P3> = g
-            .positions()
-            .iter()
-            .map(|p| P3::new(p.x, p.y, 0.3 * (3.0 * p.x).sin() * (2.0 * p.y).cos()))
-            .collect();
+        let p: Vec<P3> =
+            g.positions().iter().map(|p| P3::new(p.x, p.y, 0.3 * (3.0 * p.x).sin() * (2.0 * p.y).cos())).collect();
         g.with_positions(p).unwrap()
     }
 
@@ -74,11 +71,9 @@ mod tests {
     fn all_weights_give_injective_maps_with_small_residual() {
         let m = bumpy_disk();
         for w in [Weights::Uniform, Weights::Cotan, Weights::MeanValue] {
-            for shape in [BoundaryShape::Circle] {
-                let r = parameterize_disk(&m, &DiskParamOptions { weights: w, boundary: shape.clone() }).unwrap();
-                assert!(r.injectivity.is_injective(), "{w:?} {shape:?}: {:?}", r.injectivity);
-                assert!(r.residual < 1e-10, "{w:?} residual {}", r.residual);
-            }
+            let r = parameterize_disk(&m, &DiskParamOptions { weights: w, boundary: BoundaryShape::Circle }).unwrap();
+            assert!(r.injectivity.is_injective(), "{w:?}: {:?}", r.injectivity);
+            assert!(r.residual < 1e-10, "{w:?} residual {}", r.residual);
         }
     }
 

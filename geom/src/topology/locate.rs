@@ -28,7 +28,8 @@ impl Locator {
     /// `Error::Internal` if the BVH cannot be built (the mesh has no faces).
     pub fn new(mesh: &Mesh) -> Result<Locator> {
         let v = mesh.positions().iter().map(|p| Vector::new(p.x, p.y, p.z)).collect();
-        let tri = TriMesh::new(v, mesh.face_indices()).map_err(|e| Error::Internal(format!("BVH construction: {e:?}")))?;
+        let tri =
+            TriMesh::new(v, mesh.face_indices()).map_err(|e| Error::Internal(format!("BVH construction: {e:?}")))?;
         Ok(Locator { tri })
     }
 

@@ -3,7 +3,7 @@
 use super::Uv;
 use crate::error::{InputError, Result};
 use crate::mesh::{Mesh, VertexId};
-use crate::topology::{boundary_loops, components, genus};
+use crate::topology::{boundary_loops, components, euler_characteristic};
 use serde::{Deserialize, Serialize};
 
 /// The convex polygon the boundary is mapped onto.
@@ -27,7 +27,8 @@ pub enum BoundaryShape {
 pub fn disk_boundary(mesh: &Mesh) -> Result<Vec<VertexId>> {
     let loops = boundary_loops(mesh);
     let c = components(mesh).count;
-    let g = genus(mesh);
+    // V - E + F = 2C - 2g - b, with the loops already at hand.
+    let g = (2 * c as i64 - loops.len() as i64 - euler_characteristic(mesh)) / 2;
     if loops.len() != 1 || c != 1 || g != 0 {
         return Err(InputError::NotADisk(format!(
             "need 1 component, genus 0 and 1 boundary loop; found {c} components, genus {g}, {} boundary loops",

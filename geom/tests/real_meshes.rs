@@ -106,3 +106,53 @@ fn edge_node_paths_are_shorter_than_vertex_paths_and_stay_in_the_region() {
         }
     }
 }
+
+/// Faces whose three corners are all boundary vertices (the only ones a convex-polygon map can
+/// flatten to a segment).
+fn ears(m: &Mesh) -> usize {
+    m.faces().iter().filter(|f| f.iter().all(|&v| m.is_boundary_vertex(v))).count()
+}
+
+#[test]
+fn convex_polygon_boundaries_and_reused_symbolic_factorization() {
+    use geom::linalg::FixedBoundarySystem;
+    use geom::param::{check_injective, disk_boundary, map_boundary_to_polygon};
+    let m = common::load("face.off");
+    // A regular hexagon, corners by arc length; and a triangle with explicit corners.
+    let hex: Vec<[f64; 2]> = (0..6)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / 6.0;
+            [a.cos(), a.sin()]
+        })
+        .collect();
+    let lp = disk_boundary(&m).unwrap();
+    let n = lp.len();
+    let tri = BoundaryShape::Polygon {
+        vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.5, 0.8]],
+        corners: Some(vec![0, n / 3, 2 * n / 3]),
+    };
+    for shape in [BoundaryShape::Polygon { vertices: hex, corners: None }, tri] {
+        let buv = map_boundary_to_polygon(&m, &lp, &shape).unwrap();
+        let mut fixed = vec![[0.0; 2]; m.n_vertices()];
+        for (v, p) in lp.iter().zip(&buv) {
+            fixed[v.idx()] = *p;
+        }
+        // One symbolic factorization, three numeric ones (three weight kinds).
+        let mut sys = FixedBoundarySystem::new(&m, &lp).unwrap();
+        for w in [Weights::Uniform, Weights::MeanValue, Weights::Cotan] {
+            let f = sys.factor(&m, w).unwrap();
+            let uv = f.solve::<2>(&|v| fixed[v.idx()]).unwrap();
+            assert!(f.residual(&uv) < 1e-10);
+            if w != Weights::Cotan {
+                // Positive weights on a convex polygon: no flips (Tutte, Floater). Triangles
+                // with all three corners on one straight side are degenerate, and reported so.
+                let inj = check_injective(&m, &uv);
+                assert_eq!(inj.flipped, 0, "{shape:?} {w:?}: {inj:?}");
+                assert!(inj.degenerate <= ears(&m), "{inj:?}");
+            }
+        }
+    }
+    // A non-convex polygon is refused.
+    let bad = BoundaryShape::Polygon { vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.2, 0.2], [0.0, 1.0]], corners: None };
+    assert_eq!(map_boundary_to_polygon(&m, &lp, &bad).unwrap_err().code(), "invalid_argument");
+}

@@ -5,6 +5,7 @@ mod lex;
 mod obj;
 mod off;
 mod ply;
+mod ply_binary;
 mod stl;
 
 pub use ply::write_with_face_ints as write_ply_with_face_ints;

@@ -4,7 +4,7 @@
 //! Before the payload is parsed, the header's element counts are checked against the bytes
 //! that follow it, so a lying header fails at once without allocating.
 
-use super::{ReadOptions, check_limits};
+use super::{ReadOptions, check_limits, ply_binary};
 use crate::error::{InputError, Result, parse_err};
 use crate::mesh::{Mesh, RawMesh, V3};
 use ply_rs_bw::parser::{Parser, Reader};
@@ -39,7 +39,31 @@ fn scalar(p: &Property) -> Option<f64> {
     })
 }
 
+/// Index of a vertex property in a 12-value record: x y z, nx ny nz, r g b a, u v.
+fn slot_index(name: &str) -> Option<usize> {
+    Some(match name {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        "nx" => 3,
+        "ny" => 4,
+        "nz" => 5,
+        "red" | "r" => 6,
+        "green" | "g" => 7,
+        "blue" | "b" => 8,
+        "alpha" | "a" => 9,
+        "u" | "s" | "texture_u" | "texture_s" => 10,
+        "v" | "t" | "texture_v" | "texture_t" => 11,
+        _ => return None,
+    })
+}
+
 impl PVertex {
+    fn record(&self) -> [f64; 12] {
+        let (p, n, c, t) = (self.p, self.n, self.c, self.uv);
+        [p[0], p[1], p[2], n[0], n[1], n[2], c[0], c[1], c[2], c[3], t[0], t[1]]
+    }
+
     fn slot(&mut self, name: &str) -> Option<&mut f64> {
         Some(match name {
             "x" => &mut self.p[0],
@@ -200,29 +224,53 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
         }
     }
     let mut raw = RawMesh::default();
-    let mut faces: Option<Vec<PFace>> = None;
-    let mut verts: Vec<PVertex> = Vec::new();
-    for (name, def) in &header.elements {
-        let line = rd.line();
-        match name.as_str() {
-            "vertex" => {
-                verts = vparser.read_payload_for_element(&mut rd, def, &header).map_err(|e| ply_err(e, line))?
-            }
-            "face" => {
-                if !def.properties.keys().any(|k| is_index_list(k)) {
-                    return Err(parse_err("PLY", "header", "face element has no vertex_indices list"));
+    let mut verts: Vec<[f64; 12]> = Vec::new();
+    let mut face_indices: Vec<u32> = Vec::new();
+    let mut face_sizes: Vec<u32> = Vec::new();
+    if let Some(def) = header.elements.get("face")
+        && !def.properties.keys().any(|k| is_index_list(k))
+    {
+        return Err(parse_err("PLY", "header", "face element has no vertex_indices list"));
+    }
+    match header.encoding {
+        Encoding::Ascii => {
+            for (name, def) in &header.elements {
+                let line = rd.line();
+                match name.as_str() {
+                    "vertex" => {
+                        let v: Vec<PVertex> =
+                            vparser.read_payload_for_element(&mut rd, def, &header).map_err(|e| ply_err(e, line))?;
+                        verts = v.iter().map(PVertex::record).collect();
+                    }
+                    "face" => {
+                        let faces =
+                            fparser.read_payload_for_element(&mut rd, def, &header).map_err(|e| ply_err(e, line))?;
+                        for (f, mut face) in faces.into_iter().enumerate() {
+                            let idx = face
+                                .take()
+                                .ok_or_else(|| parse_err("PLY", format!("face {f}"), "negative vertex index"))?;
+                            face_sizes.push(idx.len() as u32);
+                            face_indices.extend_from_slice(&idx);
+                        }
+                    }
+                    _ => {
+                        oparser.read_payload_for_element(&mut rd, def, &header).map_err(|e| ply_err(e, line))?;
+                    }
                 }
-                faces = Some(fparser.read_payload_for_element(&mut rd, def, &header).map_err(|e| ply_err(e, line))?);
-            }
-            _ => {
-                oparser.read_payload_for_element(&mut rd, def, &header).map_err(|e| ply_err(e, line))?;
             }
         }
+        Encoding::BinaryLittleEndian | Encoding::BinaryBigEndian => {
+            let elements: Vec<&ElementDef> = header.elements.values().collect();
+            let big = matches!(header.encoding, Encoding::BinaryBigEndian);
+            let d = ply_binary::decode(rd.get_ref(), big, &elements, &slot_index, PVertex::new().record())?;
+            verts = d.vertex_values;
+            face_indices = d.face_indices;
+            face_sizes = d.face_sizes;
+        }
     }
-    let faces = faces.unwrap_or_default();
-    raw.positions = verts.iter().map(|v| v.p).collect();
+    raw.positions = verts.iter().map(|v| [v[0], v[1], v[2]]).collect();
     if has(&["nx", "ny", "nz"]) {
-        raw.attributes.normals = Some(verts.iter().map(|v| V3::new(v.n[0], v.n[1], v.n[2])).collect());
+        raw.attributes.normals = Some(verts.iter().map(|v| V3::new(v[3], v[4], v[5])).collect());
     }
     if has(&["red", "green", "blue"]) {
         let float = matches!(
@@ -230,28 +278,19 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
             Some(PropertyType::Scalar(ScalarType::Float | ScalarType::Double))
         );
         let conv = |x: f64| if float { (x * 255.0).round().clamp(0.0, 255.0) as u8 } else { x.clamp(0.0, 255.0) as u8 };
-        raw.attributes.colors = Some(verts.iter().map(|v| v.c.map(conv)).collect());
+        raw.attributes.colors = Some(verts.iter().map(|v| [conv(v[6]), conv(v[7]), conv(v[8]), conv(v[9])]).collect());
     }
     if has(&["u", "v"]) || has(&["s", "t"]) || has(&["texture_u", "texture_v"]) {
-        raw.attributes.uvs = Some(verts.iter().map(|v| v.uv).collect());
+        raw.attributes.uvs = Some(verts.iter().map(|v| [v[10], v[11]]).collect());
     }
-    let mut all_tri = true;
-    raw.indices.reserve(faces.len() * 3);
-    let mut sizes = Vec::new();
-    for (f, mut face) in faces.into_iter().enumerate() {
-        let idx = face.take().ok_or_else(|| parse_err("PLY", format!("face {f}"), "negative vertex index"))?;
-        if idx.len() < 3 {
-            return Err(InputError::FaceTooSmall { face: f, count: idx.len() }.into());
+    for (f, &k) in face_sizes.iter().enumerate() {
+        if k < 3 {
+            return Err(InputError::FaceTooSmall { face: f, count: k as usize }.into());
         }
-        if idx.len() != 3 && all_tri {
-            all_tri = false;
-            sizes = vec![3u32; f];
-        }
-        if !all_tri {
-            sizes.push(idx.len() as u32);
-        }
-        raw.indices.extend_from_slice(&idx);
     }
+    let all_tri = face_sizes.iter().all(|&k| k == 3);
+    raw.indices = face_indices;
+    let sizes = face_sizes;
     raw.sizes = (!all_tri).then_some(sizes);
     Ok(raw)
 }

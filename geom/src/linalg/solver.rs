@@ -223,6 +223,18 @@ impl FixedBoundaryFactor<'_> {
     /// `Error::Numerical` when the solution is not finite or the relative residual exceeds
     /// [`tol::SOLVE_RESIDUAL_REL`].
     pub fn solve<const K: usize>(&self, fixed_values: &dyn Fn(VertexId) -> [f64; K]) -> Result<Vec<[f64; K]>> {
+        Ok(self.solve_with_residual(fixed_values)?.0)
+    }
+
+    /// [`FixedBoundaryFactor::solve`], also returning the largest relative residual over the
+    /// `K` columns.
+    ///
+    /// # Errors
+    /// As [`FixedBoundaryFactor::solve`].
+    pub fn solve_with_residual<const K: usize>(
+        &self,
+        fixed_values: &dyn Fn(VertexId) -> [f64; K],
+    ) -> Result<(Vec<[f64; K]>, f64)> {
         let sys = self.sys;
         let n = sys.free.len();
         let mut rhs = Mat::<f64>::zeros(n, K);
@@ -241,6 +253,7 @@ impl FixedBoundaryFactor<'_> {
         // Residual || A x - b || / || b || per column, with the sparse product done by sprs.
         let a = sprs::CsMatView::try_new_csc((n, n), &sys.col_ptr[..], &sys.row_idx[..], &self.values[..])
             .map_err(|(_, _, _, e)| Error::Internal(format!("Laplacian pattern: {e}")))?;
+        let mut worst: f64 = 0.0;
         for k in 0..K {
             let x: Vec<f64> = (0..n).map(|i| rhs[(i, k)]).collect();
             let mut axk = vec![0.0; n];
@@ -252,6 +265,9 @@ impl FixedBoundaryFactor<'_> {
                 den += bi * bi;
             }
             let rel = num.sqrt() / den.sqrt().max(tol::TINY);
+            if den > 0.0 {
+                worst = worst.max(rel);
+            }
             if !rel.is_finite() || (den > 0.0 && rel > tol::SOLVE_RESIDUAL_REL) {
                 return Err(Error::Numerical(format!(
                     "linear solve residual {rel:.3e} exceeds {:.0e}",
@@ -270,7 +286,7 @@ impl FixedBoundaryFactor<'_> {
                 }
             }
         }
-        Ok(out)
+        Ok((out, worst))
     }
 
     /// Relative residual of a full solution vector (all vertices), for tests and reports.

@@ -49,8 +49,7 @@ pub fn parameterize_disk(mesh: &Mesh, opts: &DiskParamOptions) -> Result<DiskPar
     }
     let mut sys = FixedBoundarySystem::new(mesh, &boundary)?;
     let factor = sys.factor(mesh, opts.weights)?;
-    let uv = factor.solve::<2>(&|v| fixed_uv[v.idx()])?;
-    let residual = factor.residual(&uv);
+    let (uv, residual) = factor.solve_with_residual::<2>(&|v| fixed_uv[v.idx()])?;
     let injectivity = check_injective(mesh, &uv);
     Ok(DiskParamResult { uv, boundary, injectivity, residual })
 }

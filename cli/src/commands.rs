@@ -32,16 +32,7 @@ pub fn inspect(path: &Path) -> Result<String> {
 /// `surfmap convert IN OUT`.
 pub fn convert(input: &Path, output: &Path, subdivide: usize) -> Result<String> {
     let r = read(input)?;
-    let mesh = if subdivide > 0 {
-        let faces = (r.mesh.n_faces() as u64).saturating_mul(4u64.saturating_pow(subdivide as u32));
-        let limit = geom::mesh::MeshLimits::default().max_faces;
-        if faces > limit {
-            return Err(InputError::TooLarge { what: "faces after subdivision", count: faces, limit }.into());
-        }
-        geom::mesh::shapes::subdivide(&r.mesh, subdivide)
-    } else {
-        r.mesh
-    };
+    let mesh = if subdivide > 0 { geom::mesh::shapes::try_subdivide(&r.mesh, subdivide)? } else { r.mesh };
     io::write_path(&mesh, output)?;
     let s = geom::topology::summary(&mesh);
     Ok(json!({"written": output.display().to_string(), "vertices": s.vertices, "faces": s.faces,

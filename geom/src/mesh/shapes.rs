@@ -131,12 +131,29 @@ pub fn midpoint_subdivide(pos: &[P3], tris: &[[u32; 3]]) -> (Vec<P3>, Vec<[u32; 
     (pos, out)
 }
 
-/// Subdivides a mesh `k` times by [`midpoint_subdivide`].
+/// Subdivides a mesh `k` times by [`midpoint_subdivide`] (for tests and benchmarks).
 pub fn subdivide(mesh: &Mesh, k: usize) -> Mesh {
+    match try_subdivide(mesh, k) {
+        Ok(m) => m,
+        Err(e) => panic!("subdivision of a valid mesh failed: {e}"),
+    }
+}
+
+/// Subdivides a mesh `k` times by [`midpoint_subdivide`], as a fallible call for user input.
+///
+/// # Errors
+/// `InputError::TooLarge` when the result would exceed the default face limit; any
+/// construction error (none is expected for a valid input mesh).
+pub fn try_subdivide(mesh: &Mesh, k: usize) -> crate::Result<Mesh> {
+    let faces = (mesh.n_faces() as u64).saturating_mul(4u64.saturating_pow(k.min(32) as u32));
+    let limit = super::MeshLimits::default().max_faces;
+    if faces > limit {
+        return Err(crate::InputError::TooLarge { what: "faces after subdivision", count: faces, limit }.into());
+    }
     let mut pos = mesh.positions().to_vec();
     let mut tris = mesh.face_indices();
     for _ in 0..k {
         (pos, tris) = midpoint_subdivide(&pos, &tris);
     }
-    build(pos, &tris)
+    Mesh::from_triangles(pos, &tris)
 }

@@ -156,3 +156,17 @@ fn convex_polygon_boundaries_and_reused_symbolic_factorization() {
     let bad = BoundaryShape::Polygon { vertices: vec![[0.0, 0.0], [1.0, 0.0], [0.2, 0.2], [0.0, 1.0]], corners: None };
     assert_eq!(map_boundary_to_polygon(&m, &lp, &bad).unwrap_err().code(), "invalid_argument");
 }
+
+#[test]
+fn large_disk_uses_the_coarsened_ordering_and_stays_exact() {
+    // hand_lowres subdivided three times: 51,329 vertices, above the coarsening threshold.
+    let m = geom::mesh::shapes::subdivide(&common::load("hand_lowres.obj"), 3);
+    assert!(m.n_vertices() - geom::param::disk_boundary(&m).unwrap().len() >= geom::linalg::COARSEN_MIN);
+    for w in [Weights::Cotan, Weights::MeanValue] {
+        let r = parameterize_disk(&m, &DiskParamOptions { weights: w, boundary: BoundaryShape::Circle }).unwrap();
+        assert!(r.residual < 1e-10, "{w:?}: residual {}", r.residual);
+        if w == Weights::MeanValue {
+            assert!(r.injectivity.is_injective(), "{:?}", r.injectivity);
+        }
+    }
+}

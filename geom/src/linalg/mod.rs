@@ -2,8 +2,10 @@
 //! CSC storage and products with `sprs`, and fixed-boundary solvers on `faer`'s sparse Cholesky / LU
 //! with the symbolic factorization computed once and reused for every numeric factorization.
 
+mod ordering;
 mod solver;
 mod weights;
 
+pub use ordering::{COARSEN_MIN, coarsened_amd};
 pub use solver::{FixedBoundaryFactor, FixedBoundarySystem};
 pub use weights::{DirectedWeights, Weights, directed_weights};

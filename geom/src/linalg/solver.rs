@@ -7,13 +7,17 @@
 //! [`FixedBoundaryFactor::solve`] solves for any number of right-hand sides and verifies the
 //! relative residual.
 
+use super::ordering::{COARSEN_MIN, coarsened_amd};
 use super::weights::{DirectedWeights, Weights, directed_weights};
 use crate::error::{Error, InputError, Result};
 use crate::mesh::{HalfedgeId, Mesh, VertexId};
 use crate::tol;
-use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky};
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Mat, Side, linalg::solvers::Solve};
+use faer::{Conj, Mat, Par, Side, linalg::solvers::Solve};
 
 /// Pattern and symbolic factorizations of a fixed-boundary Laplacian system.
 pub struct FixedBoundarySystem {
@@ -29,7 +33,7 @@ pub struct FixedBoundarySystem {
     slot_fwd: Vec<usize>,
     slot_rev: Vec<usize>,
     diag_slot: Vec<usize>,
-    sym_llt: Option<SymbolicLlt<usize>>,
+    sym_llt: Option<SymbolicCholesky<usize>>,
     sym_lu: Option<SymbolicLu<usize>>,
     /// Half-edge tails/heads cached.
     ends: Vec<(u32, u32)>,
@@ -41,7 +45,8 @@ pub struct FixedBoundaryFactor<'s> {
     values: Vec<f64>,
     /// `(free row, fixed vertex, weight)` couplings to the fixed values.
     coupling: Vec<(u32, u32, f64)>,
-    llt: Option<Llt<usize, f64>>,
+    /// Values of the Cholesky factor (its structure is the system's symbolic factorization).
+    llt: Option<Vec<f64>>,
     lu: Option<Lu<usize, f64>>,
 }
 
@@ -125,11 +130,31 @@ impl FixedBoundarySystem {
             sym_lu: None,
             ends,
         };
-        let pattern = sys.pattern();
-        let llt = SymbolicLlt::try_new(pattern, Side::Lower)
-            .map_err(|e| Error::Numerical(format!("symbolic Cholesky: {e:?}")))?;
-        sys.sym_llt = Some(llt);
+        sys.sym_llt = Some(sys.symbolic_cholesky()?);
         Ok(sys)
+    }
+
+    /// Symbolic Cholesky: AMD ordering, on a coarsened graph for large systems.
+    fn symbolic_cholesky(&self) -> Result<SymbolicCholesky<usize>> {
+        let n = self.free.len();
+        let fail = |e: faer::sparse::FaerError| Error::Numerical(format!("symbolic Cholesky: {e:?}"));
+        if n < COARSEN_MIN {
+            return factorize_symbolic_cholesky(
+                self.pattern(),
+                Side::Lower,
+                SymmetricOrdering::Amd,
+                Default::default(),
+            )
+            .map_err(fail);
+        }
+        let order = coarsened_amd(&self.col_ptr, &self.row_idx)?;
+        let mut inverse = vec![0usize; n];
+        for (k, &i) in order.iter().enumerate() {
+            inverse[i] = k;
+        }
+        let perm = PermRef::new_checked(&order, &inverse, n);
+        factorize_symbolic_cholesky(self.pattern(), Side::Lower, SymmetricOrdering::Custom(perm), Default::default())
+            .map_err(fail)
     }
 
     fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
@@ -194,11 +219,21 @@ impl FixedBoundarySystem {
         let mat = SparseColMatRef::new(self.pattern(), &values);
         let (mut llt, mut lu) = (None, None);
         if symmetric {
-            let sym = self.sym_llt.clone().ok_or_else(|| Error::Internal("missing symbolic Cholesky".into()))?;
-            llt = Some(
-                Llt::try_new_with_symbolic(sym, mat, Side::Lower)
-                    .map_err(|e| Error::Numerical(format!("Cholesky factorization failed ({n} unknowns): {e:?}")))?,
-            );
+            let sym = self.sym_llt.as_ref().ok_or_else(|| Error::Internal("missing symbolic Cholesky".into()))?;
+            let mut l_values = vec![0.0; sym.len_val()];
+            let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
+                .map_err(|e| Error::Numerical(format!("Cholesky workspace: {e:?}")))?;
+            sym.factorize_numeric_llt::<f64>(
+                &mut l_values,
+                mat,
+                Side::Lower,
+                Default::default(),
+                Par::Seq,
+                MemStack::new(&mut buf),
+                Default::default(),
+            )
+            .map_err(|e| Error::Numerical(format!("Cholesky factorization failed ({n} unknowns): {e:?}")))?;
+            llt = Some(l_values);
         } else {
             let sym = match &self.sym_lu {
                 Some(s) => s.clone(),
@@ -246,7 +281,16 @@ impl FixedBoundaryFactor<'_> {
         }
         let b = rhs.clone();
         match (&self.llt, &self.lu) {
-            (Some(f), _) => f.solve_in_place(rhs.as_mut()),
+            (Some(values), _) => {
+                let sym = sys.sym_llt.as_ref().ok_or_else(|| Error::Internal("missing symbolic Cholesky".into()))?;
+                let mut buf = MemBuffer::new(sym.solve_in_place_scratch::<f64>(K, Par::Seq));
+                LltRef::new(sym, values).solve_in_place_with_conj(
+                    Conj::No,
+                    rhs.as_mut(),
+                    Par::Seq,
+                    MemStack::new(&mut buf),
+                );
+            }
             (_, Some(f)) => f.solve_in_place(rhs.as_mut()),
             _ => return Err(Error::Internal("no factorization".into())),
         }

@@ -159,7 +159,7 @@ fn convex_polygon_boundaries_and_reused_symbolic_factorization() {
 
 #[test]
 fn large_disk_uses_the_coarsened_ordering_and_stays_exact() {
-    // hand_lowres subdivided three times: 51,329 vertices, above the coarsening threshold.
+    // hand_lowres subdivided three times: 51,329 vertices, well above the coarsening threshold.
     let m = geom::mesh::shapes::subdivide(&common::load("hand_lowres.obj"), 3);
     assert!(m.n_vertices() - geom::param::disk_boundary(&m).unwrap().len() >= geom::linalg::COARSEN_MIN);
     for w in [Weights::Cotan, Weights::MeanValue] {

@@ -169,6 +169,3 @@ pub fn write_path(mesh: &Mesh, path: &Path) -> Result<()> {
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
     std::fs::write(path, bytes).map_err(|e| crate::Error::Internal(format!("cannot write {}: {e}", path.display())))
 }
-
-/// Re-exported so callers can build raw meshes for [`Mesh::from_raw`].
-pub type Raw = RawMesh;

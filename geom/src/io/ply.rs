@@ -283,15 +283,10 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
     if has(&["u", "v"]) || has(&["s", "t"]) || has(&["texture_u", "texture_v"]) {
         raw.attributes.uvs = Some(verts.iter().map(|v| [v[10], v[11]]).collect());
     }
-    for (f, &k) in face_sizes.iter().enumerate() {
-        if k < 3 {
-            return Err(InputError::FaceTooSmall { face: f, count: k as usize }.into());
-        }
-    }
+    // Faces smaller than triangles are refused by `Mesh::from_raw`, which sees the sizes.
     let all_tri = face_sizes.iter().all(|&k| k == 3);
     raw.indices = face_indices;
-    let sizes = face_sizes;
-    raw.sizes = (!all_tri).then_some(sizes);
+    raw.sizes = (!all_tri).then_some(face_sizes);
     Ok(raw)
 }
 

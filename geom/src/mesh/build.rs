@@ -2,7 +2,7 @@
 //! polygon triangulation, unreferenced-vertex removal, degenerate/duplicate face detection,
 //! orientation repair, twin linking in linear time and the manifold checks.
 
-use super::{EdgeId, FaceId, HalfedgeId, Mesh, P3, VertexAttributes, VertexId, triangulate_polygon};
+use super::{EdgeId, HalfedgeId, Mesh, P3, VertexAttributes, VertexId, triangulate_polygon};
 use crate::error::{InputError, Result};
 use serde::Serialize;
 
@@ -462,6 +462,5 @@ fn link(
             return Err(InputError::NonManifoldVertex { vertex: v, fans }.into());
         }
     }
-    let _ = FaceId::INVALID;
     Ok(mesh)
 }

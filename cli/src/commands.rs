@@ -93,3 +93,62 @@ pub fn metrics(
     let r = geom::metrics::evaluate_map(&s, &t, &m, anchors.as_deref(), gt.as_deref(), &opts)?;
     serde_json::to_string_pretty(&r).map_err(|e| Error::Internal(e.to_string()))
 }
+
+/// Progress on stderr: a redrawn bar on a terminal, nothing otherwise.
+struct StderrProgress {
+    tty: bool,
+    last: String,
+}
+
+impl geom::progress::Progress for StderrProgress {
+    fn report(&mut self, stage: &str, fraction: f64) {
+        if !self.tty {
+            return;
+        }
+        let f = fraction.clamp(0.0, 1.0);
+        let filled = (f * 30.0).round() as usize;
+        let line = format!("\r{stage:<16} [{}{}] {:>3.0}%", "#".repeat(filled), " ".repeat(30 - filled), f * 100.0);
+        if line != self.last {
+            use std::io::Write;
+            let mut e = std::io::stderr();
+            let _ = e.write_all(line.as_bytes());
+            let _ = e.flush();
+            self.last = line;
+        }
+    }
+}
+
+pub fn map(
+    source: &Path,
+    target: &Path,
+    anchors: Option<&Path>,
+    spec: Option<&Path>,
+    method: &str,
+    out: &Path,
+) -> Result<String> {
+    use geom::pipeline::{JobSpec, Method};
+    use std::io::IsTerminal;
+    let read_bytes =
+        |p: &Path| std::fs::read(p).map_err(|e| geom::InputError::Invalid(format!("cannot read {}: {e}", p.display())));
+    let spec = match (spec, anchors) {
+        (Some(s), _) => JobSpec::from_json(&read_bytes(s)?)?,
+        (None, Some(a)) => {
+            let m = if method == "greedy" { Method::Greedy } else { Method::Voronoi };
+            JobSpec::from_anchors_json(&read_bytes(a)?, m)?
+        }
+        (None, None) => return Err(geom::InputError::Spec("give --anchors or --spec".into()).into()),
+    };
+    let s = read(source)?.mesh;
+    let t = read(target)?.mesh;
+    let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
+    let (report, artifacts) = geom::pipeline::run_map(&spec, &s, &t, &mut progress)?;
+    if progress.tty {
+        eprintln!();
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| geom::InputError::Invalid(format!("cannot create {}: {e}", out.display())))?;
+    for a in &artifacts {
+        io::write_bytes(&out.join(&a.name), &a.bytes)?;
+    }
+    serde_json::to_string_pretty(&report).map_err(|e| geom::Error::Internal(e.to_string()))
+}

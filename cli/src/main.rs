@@ -47,6 +47,25 @@ enum Command {
         #[arg(long, default_value_t = 0)]
         seed: u64,
     },
+    /// Map SOURCE onto TARGET through a common base domain built from corresponding anchors.
+    /// Writes source_on_target.obj, target_on_source.obj, source_to_target.csv,
+    /// target_to_source.csv, layout.json, layout_source.ply, layout_target.ply and metrics.json.
+    Map {
+        source: PathBuf,
+        target: PathBuf,
+        /// JSON `{"anchors": [[source_vertex, target_vertex], ...]}` (0-based); method from --method.
+        #[arg(long, conflicts_with = "spec", required_unless_present = "spec")]
+        anchors: Option<PathBuf>,
+        /// The job spec `{"method": "voronoi"|"greedy", "anchors": [[s, t], ...], "options": {...}}`.
+        #[arg(long)]
+        spec: Option<PathBuf>,
+        /// Method when --anchors is given.
+        #[arg(long, default_value = "voronoi", value_parser = ["voronoi", "greedy"])]
+        method: String,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -62,6 +81,9 @@ fn main() -> ExitCode {
         Command::Convert { input, output, subdivide } => commands::convert(&input, &output, subdivide),
         Command::Metrics { source, target, mapped, anchors, gt, samples, seed } => {
             commands::metrics(&source, &target, &mapped, anchors.as_deref(), gt.as_deref(), samples, seed)
+        }
+        Command::Map { source, target, anchors, spec, method, out } => {
+            commands::map(&source, &target, anchors.as_deref(), spec.as_deref(), &method, &out)
         }
     };
     match result {

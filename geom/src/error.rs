@@ -79,6 +79,12 @@ pub enum InputError {
     NotADisk(String),
     #[error("index {index} out of range for {what} (count {count})")]
     OutOfRange { what: &'static str, index: usize, count: usize },
+    #[error("invalid anchors: {0}")]
+    Anchors(String),
+    #[error("invalid job spec: {0}")]
+    Spec(String),
+    #[error("no consistent patch layout: {0}")]
+    LayoutConflict(String),
 }
 
 impl InputError {
@@ -103,6 +109,9 @@ impl InputError {
             InputError::TopologyMismatch(_) => "topology_mismatch",
             InputError::NotADisk(_) => "not_a_disk",
             InputError::OutOfRange { .. } => "out_of_range",
+            InputError::Anchors(_) => "invalid_anchors",
+            InputError::Spec(_) => "invalid_spec",
+            InputError::LayoutConflict(_) => "layout_conflict",
         }
     }
 }

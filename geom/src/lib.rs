@@ -10,6 +10,8 @@
 //! 4. [`map::SurfaceMap`] records where every vertex lands; [`metrics`] judges the result with
 //!    the definitions of the shared evaluator.
 
+pub mod crossparam;
+pub mod domain;
 pub mod error;
 pub mod geodesic;
 pub mod io;
@@ -18,6 +20,7 @@ pub mod map;
 pub mod mesh;
 pub mod metrics;
 pub mod param;
+pub mod pipeline;
 pub mod progress;
 pub mod tol;
 pub mod topology;

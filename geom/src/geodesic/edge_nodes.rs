@@ -174,8 +174,9 @@ impl<'m> EdgeNodeGraph<'m> {
         }
     }
 
-    /// Neighbours of `n` with the face (or edge) that carries each arc; `allowed` filters faces.
-    fn neighbors(&self, n: NodeId, allowed: &dyn Fn(FaceId) -> bool, mut f: impl FnMut(NodeId)) {
+    /// Neighbours of `n`, each with the face its arc crosses (`None` for an arc along an edge);
+    /// `allowed` filters faces.
+    pub fn arcs(&self, n: NodeId, allowed: &dyn Fn(FaceId) -> bool, mut f: impl FnMut(NodeId, Option<FaceId>)) {
         let m = self.mesh;
         match self.as_edge_node(n) {
             None => {
@@ -186,15 +187,15 @@ impl<'m> EdgeNodeGraph<'m> {
                     let edge_ok = allowed(face) || m.twin(h).is_some_and(|t| allowed(t.face()));
                     if edge_ok {
                         // Along the outgoing edge: the nearest node on it.
-                        f(self.first_along(e_out, v));
+                        f(self.first_along(e_out, v), None);
                     }
                     if allowed(face) {
                         // Across the face: interior nodes of the opposite edge.
-                        self.for_edge_interior(m.edge(h.next()), &mut f);
+                        self.for_edge_interior(m.edge(h.next()), |w| f(w, Some(face)));
                     }
                     let p = h.prev();
                     if m.twin(p).is_none() && allowed(face) {
-                        f(self.first_along(m.edge(p), v));
+                        f(self.first_along(m.edge(p), v), None);
                     }
                 }
             }
@@ -203,16 +204,17 @@ impl<'m> EdgeNodeGraph<'m> {
                 let h = m.edge_halfedge(e);
                 let edge_ok = allowed(h.face()) || m.twin(h).is_some_and(|t| allowed(t.face()));
                 if edge_ok {
-                    f(if i == 0 { NodeId(m.tail(h).0) } else { NodeId(n.0 - 1) });
-                    f(if i + 1 == k { NodeId(m.head(h).0) } else { NodeId(n.0 + 1) });
+                    f(if i == 0 { NodeId(m.tail(h).0) } else { NodeId(n.0 - 1) }, None);
+                    f(if i + 1 == k { NodeId(m.head(h).0) } else { NodeId(n.0 + 1) }, None);
                 }
                 for side in [Some(h), m.twin(h)].into_iter().flatten() {
                     if !allowed(side.face()) {
                         continue;
                     }
-                    f(NodeId(m.tail(side.prev()).0));
-                    self.for_edge_interior(m.edge(side.next()), &mut f);
-                    self.for_edge_interior(m.edge(side.prev()), &mut f);
+                    let face = side.face();
+                    f(NodeId(m.tail(side.prev()).0), Some(face));
+                    self.for_edge_interior(m.edge(side.next()), |w| f(w, Some(face)));
+                    self.for_edge_interior(m.edge(side.prev()), |w| f(w, Some(face)));
                 }
             }
         }
@@ -236,19 +238,33 @@ impl<'m> EdgeNodeGraph<'m> {
     /// `InputError::Invalid` for masks of the wrong size or nodes out of range.
     pub fn shortest_path(&self, from: NodeId, to: NodeId, opts: &PathOptions) -> Result<Option<SurfacePath>> {
         let nn = self.n_nodes();
-        if from.0 as usize >= nn || to.0 as usize >= nn {
-            return Err(
-                InputError::OutOfRange { what: "path node", index: from.0.max(to.0) as usize, count: nn }.into()
-            );
-        }
         if opts.faces.is_some_and(|m| m.len() != self.mesh.n_faces()) {
             return Err(InputError::Invalid("face mask size differs from the face count".into()).into());
         }
         if opts.blocked.is_some_and(|m| m.len() != nn) {
             return Err(InputError::Invalid("blocked-node mask size differs from the node count".into()).into());
         }
-        let allowed = |f: FaceId| opts.faces.is_none_or(|m| m[f.idx()]);
-        let blocked = |n: NodeId| n != to && opts.blocked.is_some_and(|m| m[n.0 as usize]);
+        self.shortest_path_filtered(from, to, opts)
+    }
+
+    /// Shortest path between two nodes under an arbitrary [`SearchFilter`] (A* with the
+    /// Euclidean distance to `to`), or `None` when `to` cannot be reached.
+    ///
+    /// # Errors
+    /// `InputError::OutOfRange` for nodes out of range.
+    pub fn shortest_path_filtered(
+        &self,
+        from: NodeId,
+        to: NodeId,
+        filter: &dyn SearchFilter,
+    ) -> Result<Option<SurfacePath>> {
+        let nn = self.n_nodes();
+        if from.0 as usize >= nn || to.0 as usize >= nn {
+            return Err(
+                InputError::OutOfRange { what: "path node", index: from.0.max(to.0) as usize, count: nn }.into()
+            );
+        }
+        let allowed = |f: FaceId| filter.face_ok(f);
         let mut guard = self.scratch.borrow_mut();
         let s = &mut *guard;
         if s.stamp.len() != nn {
@@ -285,9 +301,9 @@ impl<'m> EdgeNodeGraph<'m> {
             }
             let du = s.dist[ui];
             let pu = self.pos[ui];
-            let mut relax = |w: NodeId| {
+            let mut relax = |w: NodeId, face: Option<FaceId>| {
                 let wi = w.0 as usize;
-                if blocked(w) {
+                if w != to && !filter.node_ok(w) {
                     return;
                 }
                 if s.stamp[wi] != generation {
@@ -299,13 +315,13 @@ impl<'m> EdgeNodeGraph<'m> {
                     return;
                 }
                 let nd = du + (self.pos[wi] - pu).norm();
-                if nd < s.dist[wi] {
+                if nd < s.dist[wi] && filter.arc_ok(face, NodeId(u), w) {
                     s.dist[wi] = nd;
                     s.pred[wi] = u;
                     s.heap.push(nd + h(w.0), w.0);
                 }
             };
-            self.neighbors(NodeId(u), &allowed, &mut relax);
+            self.arcs(NodeId(u), &allowed, &mut relax);
         }
         if !found {
             return Ok(None);
@@ -321,6 +337,92 @@ impl<'m> EdgeNodeGraph<'m> {
         drop(guard);
         let points = nodes.iter().map(|&n| self.surface_point(n)).collect();
         Ok(Some(SurfacePath { nodes, points, length }))
+    }
+
+    /// Cyclic position of node `n` on the boundary of face `f`: corner `k` is `k << 16`, and
+    /// the nodes on the side from corner `k` to corner `k+1` follow it in order. `None` when
+    /// `n` is not on the boundary of `f`. Chords between such positions cross exactly when
+    /// their ends interleave, which makes intersection tests purely combinatorial.
+    pub fn face_position(&self, f: FaceId, n: NodeId) -> Option<u32> {
+        let m = self.mesh;
+        for k in 0..3u32 {
+            let h = crate::mesh::HalfedgeId::of(f, k as usize);
+            match self.as_edge_node(n) {
+                None => {
+                    if m.tail(h).0 == n.0 {
+                        return Some(k << 16);
+                    }
+                }
+                Some((e, i)) => {
+                    if m.edge(h) == e {
+                        let c = self.count[e.idx()];
+                        let off = if m.edge_halfedge(e) == h { i + 1 } else { c - i };
+                        return Some((k << 16) | off);
+                    }
+                }
+            }
+        }
+        None
+    }
+
+    /// Angular key of node `n` around vertex `v` (counter-clockwise order of
+    /// [`Mesh::outgoing`]), if `n` is adjacent to `v`: every first step of a path leaving `v`
+    /// lands on such a node, so keys order the paths at an anchor without any geometry.
+    pub fn ring_key(&self, v: VertexId, n: NodeId) -> Option<u32> {
+        let m = self.mesh;
+        for (k, h) in m.outgoing(v).enumerate() {
+            let k = k as u32;
+            if self.first_along(m.edge(h), v) == n {
+                return Some((2 * k) << 16);
+            }
+            let opp = h.next();
+            if let Some((e, i)) = self.as_edge_node(n)
+                && m.edge(opp) == e
+            {
+                let c = self.count[e.idx()];
+                let j = if m.edge_halfedge(e) == opp { i } else { c - 1 - i };
+                return Some(((2 * k + 1) << 16) | j);
+            }
+            let p = h.prev();
+            if m.twin(p).is_none() && self.first_along(m.edge(p), v) == n {
+                return Some(((2 * k + 1) << 16) | 0xffff);
+            }
+        }
+        None
+    }
+
+    /// The nodes adjacent to vertex `v` (its ring), with their [`Self::ring_key`]s.
+    pub fn ring(&self, v: VertexId) -> Vec<(NodeId, u32)> {
+        let mut out = Vec::new();
+        self.arcs(NodeId(v.0), &|_| true, |w, _| out.push(w));
+        out.sort_unstable();
+        out.dedup();
+        out.into_iter().filter_map(|w| self.ring_key(v, w).map(|k| (w, k))).collect()
+    }
+}
+
+/// Restrictions on a path search: which nodes, faces and arcs it may use.
+pub trait SearchFilter {
+    /// May the search pass through node `n`? (The target is always allowed.)
+    fn node_ok(&self, _n: NodeId) -> bool {
+        true
+    }
+    /// May the search cross face `f`?
+    fn face_ok(&self, _f: FaceId) -> bool {
+        true
+    }
+    /// May the search use the arc `from -> to`, which crosses `face` (`None`: along an edge)?
+    fn arc_ok(&self, _face: Option<FaceId>, _from: NodeId, _to: NodeId) -> bool {
+        true
+    }
+}
+
+impl SearchFilter for PathOptions<'_> {
+    fn node_ok(&self, n: NodeId) -> bool {
+        self.blocked.is_none_or(|m| !m[n.0 as usize])
+    }
+    fn face_ok(&self, f: FaceId) -> bool {
+        self.faces.is_none_or(|m| m[f.idx()])
     }
 }
 

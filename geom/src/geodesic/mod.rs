@@ -7,6 +7,6 @@ mod face_voronoi;
 mod heap;
 mod vertex_dijkstra;
 
-pub use edge_nodes::{EdgeNodeGraph, EdgeNodeOptions, NodeId, PathOptions, SurfacePath, shortest_path};
+pub use edge_nodes::{EdgeNodeGraph, EdgeNodeOptions, NodeId, PathOptions, SearchFilter, SurfacePath, shortest_path};
 pub use face_voronoi::{FaceVoronoiOptions, FaceVoronoiResult, face_voronoi};
 pub use vertex_dijkstra::{VertexDijkstraOptions, VertexDijkstraResult, vertex_dijkstra};

@@ -1,0 +1,16 @@
+//! Cross-parameterization over a common base domain (Kraevoy & Sheffer 2004, section 4): every
+//! patch of both refined meshes is mapped onto one shared canonical triangle ([`patch_param`]),
+//! and a vertex of one mesh is carried to the other by locating its triangle coordinates in the
+//! other mesh's embedding of the same patch ([`compose`], [`locate2d`]). [`smooth`] then lowers
+//! the stretch by relocating vertices inside the common domain.
+
+pub mod compose;
+pub mod locate2d;
+pub mod patch_param;
+pub mod smooth;
+
+pub use compose::compose;
+pub use patch_param::{PatchParam, PatchParamOptions, parameterize_patches};
+
+/// The canonical triangle's corners, counter-clockwise.
+pub const TRIANGLE: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.5, 0.866_025_403_784_438_6]];

@@ -1,0 +1,138 @@
+//! Each patch of a refined mesh onto the canonical triangle: corners at the patch's anchors,
+//! sides by arc length along the layout paths, interior by mean-value coordinates (Floater
+//! 2003), which embed a disk bijectively for any convex boundary. The corner order is the
+//! walk's, so every mesh places the same anchor at the same corner and the same path on the
+//! same side.
+
+use super::TRIANGLE;
+use super::locate2d::Grid;
+use crate::domain::Patch;
+use crate::domain::refine::Refined;
+use crate::error::{Error, Result};
+use crate::linalg::{FixedBoundarySystem, Weights};
+use crate::mesh::{FaceId, Mesh, VertexId};
+use crate::param::{BoundaryShape, Uv, check_injective, disk_boundary, map_boundary_to_polygon};
+use crate::progress::Progress;
+use serde::{Deserialize, Serialize};
+
+/// Options for [`parameterize_patches`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct PatchParamOptions {
+    pub weights: Weights,
+}
+
+impl Default for PatchParamOptions {
+    fn default() -> Self {
+        Self { weights: Weights::MeanValue }
+    }
+}
+
+/// One patch flattened onto the canonical triangle.
+pub struct PatchParam {
+    /// The patch as a mesh of its own.
+    pub local: Mesh,
+    /// Local vertex -> refined vertex.
+    pub global_v: Vec<VertexId>,
+    /// Local face -> refined face.
+    pub global_f: Vec<FaceId>,
+    /// Local vertex -> triangle coordinates.
+    pub uv: Vec<Uv>,
+    /// Local boundary vertices (fixed in the solve).
+    pub boundary: Vec<VertexId>,
+    pub tris: Vec<[u32; 3]>,
+    pub grid: Grid,
+    pub residual: f64,
+}
+
+impl PatchParam {
+    /// The refined face and its barycentric coordinates at triangle point `p`.
+    pub fn locate(&self, p: Uv) -> (FaceId, [f64; 3]) {
+        let (f, b) = self.grid.locate(&self.uv, &self.tris, p);
+        (self.global_f[f as usize], b)
+    }
+}
+
+/// Flattens every patch of `r` (the faces labelled with it) onto [`TRIANGLE`].
+///
+/// # Errors
+/// `Error::Numerical` when a patch is not a disk with its three corners on the boundary, or
+/// its embedding folds.
+pub fn parameterize_patches(
+    r: &Refined,
+    patches: &[Patch],
+    anchors: &[VertexId],
+    opts: &PatchParamOptions,
+    progress: &mut dyn Progress,
+) -> Result<Vec<PatchParam>> {
+    let mut faces_of: Vec<Vec<usize>> = vec![Vec::new(); patches.len()];
+    for (f, &p) in r.patch.iter().enumerate() {
+        faces_of[p as usize].push(f);
+    }
+    let mut out = Vec::with_capacity(patches.len());
+    let mut local_of = vec![u32::MAX; r.mesh.n_vertices()];
+    for (pi, (patch, faces)) in patches.iter().zip(&faces_of).enumerate() {
+        progress.check()?;
+        progress.report("parameterize", pi as f64 / patches.len().max(1) as f64);
+        let mut global_v = Vec::new();
+        let mut tris = Vec::with_capacity(faces.len());
+        for &f in faces {
+            let t = r.mesh.face(FaceId::from_idx(f)).map(|v| {
+                if local_of[v.idx()] == u32::MAX {
+                    local_of[v.idx()] = global_v.len() as u32;
+                    global_v.push(v);
+                }
+                local_of[v.idx()]
+            });
+            tris.push(t);
+        }
+        for v in &global_v {
+            local_of[v.idx()] = u32::MAX;
+        }
+        let positions = global_v.iter().map(|&v| r.mesh.position(v)).collect();
+        let local = Mesh::from_triangles(positions, &tris)
+            .map_err(|e| Error::Numerical(format!("patch {pi} is not a valid mesh: {e}")))?;
+        let mut lp = disk_boundary(&local).map_err(|e| Error::Numerical(format!("patch {pi}: {e}")))?;
+        let corner_local = |a: u32| {
+            let v = anchors[a as usize];
+            global_v.iter().position(|&g| g == v).map(|i| VertexId::from_idx(i))
+        };
+        let c = patch.corners.map(corner_local);
+        let [Some(c0), Some(c1), Some(c2)] = c else {
+            return Err(Error::Numerical(format!("patch {pi} does not contain its corners")));
+        };
+        let Some(s) = lp.iter().position(|&v| v == c0) else {
+            return Err(Error::Numerical(format!("corner of patch {pi} is not on its boundary")));
+        };
+        lp.rotate_left(s);
+        let p2 = lp.iter().position(|&v| v == c2);
+        let p1 = lp.iter().position(|&v| v == c1);
+        let (Some(p2), Some(p1)) = (p2, p1) else {
+            return Err(Error::Numerical(format!("corner of patch {pi} is not on its boundary")));
+        };
+        if !(0 < p2 && p2 < p1) {
+            return Err(Error::Numerical(format!("patch {pi} has its corners in the wrong order")));
+        }
+        let shape = BoundaryShape::Polygon { vertices: TRIANGLE.to_vec(), corners: Some(vec![0, p2, p1]) };
+        let buv = map_boundary_to_polygon(&local, &lp, &shape)?;
+        let mut fixed = vec![[f64::NAN; 2]; local.n_vertices()];
+        for (v, p) in lp.iter().zip(&buv) {
+            fixed[v.idx()] = *p;
+        }
+        let (uv, residual) = if lp.len() == local.n_vertices() {
+            (fixed.clone(), 0.0)
+        } else {
+            let mut sys = FixedBoundarySystem::new(&local, &lp)?;
+            let fac = sys.factor(&local, opts.weights)?;
+            fac.solve_with_residual::<2>(&|v| fixed[v.idx()])?
+        };
+        let inj = check_injective(&local, &uv);
+        if inj.flipped > 0 {
+            return Err(Error::Numerical(format!("patch {pi} folds: {} flipped triangles", inj.flipped)));
+        }
+        let grid = Grid::new(&uv, &tris);
+        let global_f = faces.iter().map(|&f| FaceId::from_idx(f)).collect();
+        out.push(PatchParam { local, global_v, global_f, uv, boundary: lp, tris, grid, residual });
+    }
+    Ok(out)
+}

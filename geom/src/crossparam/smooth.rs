@@ -1,0 +1,185 @@
+//! Stretch-reducing relocation of mapped vertices across patch boundaries, in the spirit of
+//! Kraevoy & Sheffer 2004, section 5. The patch-wise map is continuous but kinks where patches
+//! meet; here every free vertex's image moves, one at a time (Gauss-Seidel), towards the
+//! mean-value combination of its neighbours' images, and is projected back onto the target
+//! surface (BVH closest point). A move is kept only if it lowers the local symmetric Dirichlet
+//! stretch of the incident triangles (Sander's L2 plus its inverse, so triangles cannot
+//! collapse) and leaves every incident triangle facing the way the target does; so the result
+//! stays on the surface and flip-free, and anchors never move.
+
+use crate::error::Result;
+use crate::map::SurfaceMap;
+use crate::mesh::{FaceId, Mesh, P3, V3, VertexId};
+use crate::progress::Progress;
+use crate::topology::Locator;
+use serde::{Deserialize, Serialize};
+
+/// Options for [`smooth`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SmoothOptions {
+    /// Sweeps over all vertices (0 disables smoothing).
+    pub iterations: usize,
+    /// Fraction of the way to the relaxed position tried first (halved on rejection, twice).
+    pub step: f64,
+}
+
+impl Default for SmoothOptions {
+    fn default() -> Self {
+        Self { iterations: 5, step: 1.0 }
+    }
+}
+
+/// What smoothing did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct SmoothReport {
+    pub moves: usize,
+    pub rejected: usize,
+    pub energy_before: f64,
+    pub energy_after: f64,
+}
+
+impl SmoothReport {
+    pub fn merge(self, o: SmoothReport) -> SmoothReport {
+        SmoothReport {
+            moves: self.moves + o.moves,
+            rejected: self.rejected + o.rejected,
+            energy_before: self.energy_before + o.energy_before,
+            energy_after: self.energy_after + o.energy_after,
+        }
+    }
+}
+
+/// Symmetric Dirichlet energy of the affine map from source triangle `s` to mapped `m`, times
+/// the source area; `None` for a degenerate mapped triangle.
+fn tri_energy(s: [P3; 3], m: [P3; 3], scale: f64) -> Option<f64> {
+    let m = m.map(|p| P3::from(p.coords * scale));
+    let frame = |p: [P3; 3]| {
+        let e1 = p[1] - p[0];
+        let e2 = p[2] - p[0];
+        let l = e1.norm();
+        let n = e1.cross(&e2);
+        let nn = n.norm();
+        if l == 0.0 || nn == 0.0 {
+            return None;
+        }
+        let x = e1 / l;
+        let y = (n / nn).cross(&x);
+        Some(([l, e2.dot(&x)], [0.0, e2.dot(&y)], 0.5 * nn))
+    };
+    let (s0, s1, area_s) = frame(s)?;
+    let (m0, m1, area_m) = frame(m)?;
+    // J = M S^-1 with S = [[s0.0, s0.1],[s1.0, s1.1]] (upper triangular).
+    let det_s = s0[0] * s1[1];
+    let inv = [[1.0 / s0[0], -s0[1] / det_s], [0.0, 1.0 / s1[1]]];
+    let j = [[m0[0] * inv[0][0], m0[0] * inv[0][1] + m0[1] * inv[1][1]], [0.0, m1[1] * inv[1][1]]];
+    let fro = j[0][0].powi(2) + j[0][1].powi(2) + j[1][1].powi(2);
+    let det = j[0][0] * j[1][1];
+    if det <= 0.0 {
+        return None;
+    }
+    let _ = area_m;
+    Some(area_s * (fro + fro / (det * det)))
+}
+
+/// Relaxes `map: source -> target`. `fixed` vertices (the anchors) never move.
+///
+/// # Errors
+/// `Cancelled`; `Error::Internal` if the target's BVH cannot be built.
+pub fn smooth(
+    source: &Mesh,
+    target: &Mesh,
+    mut map: SurfaceMap,
+    fixed: &[VertexId],
+    opts: &SmoothOptions,
+    progress: &mut dyn Progress,
+) -> Result<(SurfaceMap, SmoothReport)> {
+    let mut rep = SmoothReport::default();
+    if opts.iterations == 0 {
+        return Ok((map, rep));
+    }
+    let n = source.n_vertices();
+    let loc = Locator::new(target)?;
+    let scale = (source.area() / target.area().max(f64::MIN_POSITIVE)).sqrt();
+    let mut pos: Vec<P3> = (0..n).map(|v| map.position(VertexId::from_idx(v), target)).collect();
+    let mut is_fixed = vec![false; n];
+    for v in fixed {
+        is_fixed[v.idx()] = true;
+    }
+    // The target's normal at each image, from the face it lies on.
+    let tnormal = |f: FaceId| -> V3 { target.face_normal_raw(f) };
+    let mut img_face: Vec<FaceId> = map.face.clone();
+    let star_energy = |v: VertexId, pos: &[P3], img_face: &[FaceId], p: P3, f: FaceId| -> Option<f64> {
+        let mut e = 0.0;
+        for h in source.outgoing(v) {
+            let tri = source.face(h.face());
+            let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
+            // Orientation against the target at all three corners' faces.
+            let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+            let faces = tri.map(|w| if w == v { f } else { img_face[w.idx()] });
+            if faces.iter().all(|&g| nm.dot(&tnormal(g)) < 0.0) {
+                return None;
+            }
+            if nm.dot(&tnormal(f)) <= 0.0 {
+                return None;
+            }
+            e += tri_energy(source.face_points(h.face()), m, scale)?;
+        }
+        Some(e)
+    };
+    let total = |pos: &[P3], img_face: &[FaceId]| -> f64 {
+        (0..source.n_faces())
+            .filter_map(|f| {
+                let tri = source.face(FaceId::from_idx(f));
+                tri_energy(source.face_points(FaceId::from_idx(f)), tri.map(|w| pos[w.idx()]), scale)
+            })
+            .sum::<f64>()
+            + 0.0 * img_face.len() as f64
+    };
+    rep.energy_before = total(&pos, &img_face);
+    for it in 0..opts.iterations {
+        progress.check()?;
+        progress.report("smooth", it as f64 / opts.iterations as f64);
+        for vi in 0..n {
+            if is_fixed[vi] {
+                continue;
+            }
+            let v = VertexId::from_idx(vi);
+            // Uniform relaxation target in 3D (the neighbours' images), then the surface.
+            let (mut c, mut k) = (V3::zeros(), 0.0);
+            for w in source.vertex_neighbors(v) {
+                c += pos[w.idx()].coords;
+                k += 1.0;
+            }
+            if k == 0.0 {
+                continue;
+            }
+            let goal = P3::from(c / k);
+            let Some(cur) = star_energy(v, &pos, &img_face, pos[vi], img_face[vi]) else { continue };
+            let mut step = opts.step;
+            let mut moved = false;
+            for _ in 0..3 {
+                let trial = P3::from(pos[vi].coords + (goal - pos[vi]) * step);
+                let pr = loc.project(&trial);
+                if let Some(e) = star_energy(v, &pos, &img_face, pr.point, pr.face)
+                    && e < cur
+                {
+                    pos[vi] = pr.point;
+                    img_face[vi] = pr.face;
+                    map.face[vi] = pr.face;
+                    map.bary[vi] = pr.bary;
+                    moved = true;
+                    break;
+                }
+                step *= 0.5;
+            }
+            if moved {
+                rep.moves += 1;
+            } else {
+                rep.rejected += 1;
+            }
+        }
+    }
+    rep.energy_after = total(&pos, &img_face);
+    Ok((map, rep))
+}

@@ -1,0 +1,170 @@
+//! Completing a layout into a triangulation (Kwok et al. 5.1, "patch triangulation", and the
+//! same step of Kraevoy & Sheffer): every region that is not a triangle gets a path between two
+//! of its corners that are not adjacent along its boundary, shortest first, traced inside the
+//! region (the sectors of the two corners confine it). Regions that are not disks (a cylinder
+//! or a handle left between paths) are opened by a path between corners of two different
+//! walks. Works on several meshes at once: a path is inserted only if it traces on all of them.
+
+use super::tracer::{TraceRequest, Tracer};
+use super::walks::{Walk, graph_components, walks};
+use crate::error::{InputError, Result};
+use crate::progress::Progress;
+
+/// Counts of what completion added.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct CompleteStats {
+    pub diagonals: usize,
+    pub attempts: usize,
+}
+
+fn dist(t: &Tracer, a: u32, b: u32) -> f64 {
+    let m = t.mesh();
+    (m.position(t.anchors()[a as usize]) - m.position(t.anchors()[b as usize])).norm()
+}
+
+/// Traces one path on every tracer, each with the sectors of its own walk corners; inserts
+/// on all or none. `corners` are (walk index, corner index) in the walks of each tracer.
+fn try_link(ts: &mut [&mut Tracer], ends: [(usize, usize); 2], stats: &mut CompleteStats) -> Result<bool> {
+    let mut found = Vec::with_capacity(ts.len());
+    for t in ts.iter_mut() {
+        stats.attempts += 1;
+        let ws = walks(t);
+        let (w1, c1) = ends[0];
+        let (w2, c2) = ends[1];
+        let a = ws[w1].corners(t)[c1];
+        let b = ws[w2].corners(t)[c2];
+        let req = TraceRequest {
+            a,
+            b,
+            sector_a: Some(ws[w1].sector(t, c1)),
+            sector_b: Some(ws[w2].sector(t, c2)),
+            ..Default::default()
+        };
+        match t.trace(&req)? {
+            Some(p) => found.push(p),
+            None => {
+                if std::env::var_os("SURFMAP_DEBUG").is_some() {
+                    let free = t.trace(&TraceRequest { a, b, ..Default::default() })?.is_some();
+                    eprintln!(
+                        "link {a}-{b} failed; sectors {:?} {:?}; unconstrained ok: {free}; rot a {:?} rot b {:?}",
+                        req.sector_a,
+                        req.sector_b,
+                        t.rotation(a),
+                        t.rotation(b)
+                    );
+                }
+                return Ok(false);
+            }
+        }
+    }
+    for (t, p) in ts.iter_mut().zip(found) {
+        t.insert(p)?;
+    }
+    stats.diagonals += 1;
+    Ok(true)
+}
+
+/// Adds paths until every region is a triangle and the layout is cellular (`V - E + W = χ`).
+///
+/// # Errors
+/// `InputError::LayoutConflict` when some region cannot be triangulated within
+/// `max_attempts` traces; `Cancelled`.
+pub fn complete(
+    ts: &mut [&mut Tracer],
+    chi: i64,
+    max_attempts: usize,
+    progress: &mut dyn Progress,
+) -> Result<CompleteStats> {
+    let mut stats = CompleteStats::default();
+    'outer: loop {
+        progress.check()?;
+        if stats.attempts > max_attempts {
+            return Err(InputError::LayoutConflict(format!(
+                "gave up completing the layout after {} path searches",
+                stats.attempts
+            ))
+            .into());
+        }
+        let t0: &Tracer = ts[0];
+        let (comps, all) = graph_components(t0);
+        if !all || comps != 1 {
+            return Err(InputError::LayoutConflict(format!(
+                "the paths leave {comps} separate groups of anchors{}",
+                if all { "" } else { " and some anchors unlinked" }
+            ))
+            .into());
+        }
+        let ws = walks(t0);
+        // 1. Split non-triangular walks by their shortest admissible diagonal.
+        for (wi, w) in ws.iter().enumerate() {
+            if w.is_triangle(t0) {
+                continue;
+            }
+            let c = w.corners(t0);
+            let n = c.len();
+            if n < 3 {
+                return Err(InputError::LayoutConflict(format!(
+                    "two paths between anchors {} and {} enclose a region with no other anchor",
+                    c[0],
+                    c.get(1).copied().unwrap_or(c[0])
+                ))
+                .into());
+            }
+            let mut cand: Vec<(f64, usize, usize)> = Vec::new();
+            for i in 0..n {
+                for j in i + 2..n {
+                    if i == 0 && j == n - 1 || c[i] == c[j] {
+                        continue;
+                    }
+                    cand.push((dist(t0, c[i], c[j]), i, j));
+                }
+            }
+            cand.sort_by(|a, b| a.0.total_cmp(&b.0));
+            for (_, i, j) in cand {
+                if try_link(ts, [(wi, i), (wi, j)], &mut stats)? {
+                    continue 'outer;
+                }
+            }
+            return Err(InputError::LayoutConflict(format!(
+                "region with corners {c:?} cannot be split into triangles by non-crossing paths"
+            ))
+            .into());
+        }
+        // 2. All triangles: if the layout is not cellular, join two walks of one region.
+        let t0: &Tracer = ts[0];
+        let na = t0.anchors().len() as i64;
+        if na - t0.paths().len() as i64 + ws.len() as i64 == chi {
+            return Ok(stats);
+        }
+        let mut cand: Vec<(f64, (usize, usize), (usize, usize))> = Vec::new();
+        for (wi, w) in ws.iter().enumerate() {
+            for (wj, x) in ws.iter().enumerate().skip(wi + 1) {
+                for (ci, &a) in w.corners(t0).iter().enumerate() {
+                    for (cj, &b) in x.corners(t0).iter().enumerate() {
+                        if a != b {
+                            cand.push((dist(t0, a, b), (wi, ci), (wj, cj)));
+                        }
+                    }
+                }
+            }
+        }
+        cand.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (_, e1, e2) in cand {
+            if stats.attempts > max_attempts {
+                break;
+            }
+            if try_link(ts, [e1, e2], &mut stats)? {
+                continue 'outer;
+            }
+        }
+        return Err(InputError::LayoutConflict(
+            "the layout does not cut the surface into disks and no joining path could be traced".into(),
+        )
+        .into());
+    }
+}
+
+/// Walks that are not triangles, for reports.
+pub fn open_walks(t: &Tracer) -> Vec<Walk> {
+    walks(t).into_iter().filter(|w| !w.is_triangle(t)).collect()
+}

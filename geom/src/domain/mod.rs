@@ -1,0 +1,102 @@
+//! Common base domains: consistent triangular patch layouts on two meshes whose corners are
+//! corresponding anchors (Kwok, Zhang, Wang 2012; Kraevoy, Sheffer 2004).
+//!
+//! [`tracer`] keeps non-crossing paths on one mesh, [`walks`] reads the regions off their
+//! rotation system, [`cuts`] finds the Voronoi cues, [`voronoi`] and [`greedy`] build the two
+//! layouts, and [`refine`] cuts a mesh along its layout into patches.
+
+pub mod complete;
+pub mod cuts;
+pub mod greedy;
+pub mod refine;
+pub mod tracer;
+pub mod voronoi;
+pub mod walks;
+
+use crate::geodesic::NodeId;
+use crate::topology::SurfacePoint;
+use serde::{Deserialize, Serialize};
+
+/// A path of a layout between anchors `a` and `b` (indices into the anchor list).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LayoutPath {
+    pub a: u32,
+    pub b: u32,
+    pub nodes: Vec<NodeId>,
+    pub points: Vec<SurfacePoint>,
+    pub length: f64,
+}
+
+/// A cyclic interval of ring keys around an anchor, both ends excluded; `from == to` means
+/// every key but that one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sector {
+    pub from: u32,
+    pub to: u32,
+}
+
+impl Sector {
+    pub fn contains(&self, k: u32) -> bool {
+        match self.from.cmp(&self.to) {
+            std::cmp::Ordering::Less => self.from < k && k < self.to,
+            std::cmp::Ordering::Greater => k > self.from || k < self.to,
+            std::cmp::Ordering::Equal => k != self.from,
+        }
+    }
+}
+
+/// A triangular patch: corner anchors and the halves that bound it (`sides[i]` runs from
+/// `corners[i]` to `corners[i + 1]`, with the patch on its right).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Patch {
+    pub corners: [u32; 3],
+    pub sides: [u32; 3],
+}
+
+/// Options shared by the layout builders.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct LayoutOptions {
+    /// Edge nodes per edge (the paper's `b` and a cap).
+    pub edge_nodes: crate::geodesic::EdgeNodeOptions,
+    /// Upper bound on paths tried while triangulating or repairing, against endless searches.
+    pub max_attempts: usize,
+}
+
+impl Default for LayoutOptions {
+    fn default() -> Self {
+        Self { edge_nodes: Default::default(), max_attempts: 20_000 }
+    }
+}
+
+/// The common base domain: the same paths (by index) and patches on both meshes.
+pub struct LayoutPair<'s, 't> {
+    pub source: tracer::Tracer<'s>,
+    pub target: tracer::Tracer<'t>,
+    pub patches: Vec<Patch>,
+    /// Stage timings and counts, for reports.
+    pub stats: LayoutStats,
+}
+
+/// What a layout construction did.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct LayoutStats {
+    pub paths: usize,
+    pub patches: usize,
+    pub cuts: usize,
+    pub multiple_linkages: usize,
+    pub triangulation_paths: usize,
+    pub postponed: usize,
+    pub failed_traces: usize,
+}
+
+/// Patches from the walks of a complete layout.
+pub fn patches_of(t: &tracer::Tracer) -> Vec<Patch> {
+    walks::walks(t)
+        .into_iter()
+        .map(|w| {
+            let c = w.corners(t);
+            Patch { corners: [c[0], c[1], c[2]], sides: [w.halves[0], w.halves[1], w.halves[2]] }
+        })
+        .collect()
+}

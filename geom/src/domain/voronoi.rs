@@ -1,0 +1,283 @@
+//! The Voronoi-cue layout of Kwok, Zhang, Wang: a source layout dual to the anchors'
+//! approximate geodesic Voronoi diagram (5.1) and its consistent copy on the target
+//! (5.2, Procedure 1).
+//!
+//! Source: one path per cut, traced inside the two clusters and forced through its cut by
+//! blocking the nodes of the pair's other cuts and of any vertex where the two clusters only
+//! touch at a point; several cuts give several linkages. Regions that are not triangles are
+//! then split ([`super::complete`]).
+//!
+//! Target: the source's paths in the paper's group order — single linkages whose target
+//! clusters share one cut (traced inside those two clusters), then single linkages between
+//! clusters that share no cut, then multiple linkages, postponed while two linkages of one pair
+//! would still leave an anchor through the same sector. Every path leaves and enters its anchors
+//! in the sector that the source's rotation prescribes, so the rotation systems agree and the
+//! target's regions are the source's.
+
+use super::complete::complete;
+use super::cuts::{Clusters, clusters};
+use super::tracer::{Half, TraceRequest, Tracer};
+use super::walks::walks;
+use super::{LayoutOptions, LayoutStats, Sector};
+use crate::error::{InputError, Result};
+use crate::geodesic::NodeId;
+use crate::mesh::{FaceId, Mesh, VertexId};
+use crate::progress::Progress;
+
+/// Nodes that a path through cut `keep` of the pair (i, j) may not use.
+fn blocked_for_cut(t: &Tracer, cl: &Clusters, keep: usize) -> Vec<NodeId> {
+    let mesh = t.mesh();
+    let g = t.graph();
+    let c = &cl.cuts[keep];
+    let (i, j) = (c.i, c.j);
+    let mut out = Vec::new();
+    for (k, other) in cl.between(i, j) {
+        if k == keep {
+            continue;
+        }
+        for &e in &other.edges {
+            for n in 0..g.edge_node_count(e) {
+                out.push(g.edge_node(e, n));
+            }
+        }
+        out.extend(other.vertices.iter().map(|&v| g.vertex_node(v)));
+    }
+    // Point contacts: vertices where the clusters touch without sharing an edge of this cut.
+    let in_keep = |v: VertexId| c.vertices.binary_search(&v).is_ok();
+    for f in 0..mesh.n_faces() {
+        if cl.label[f] != i {
+            continue;
+        }
+        for v in mesh.face(FaceId::from_idx(f)) {
+            if !in_keep(v) && mesh.vertex_faces(v).any(|g2| cl.label[g2.idx()] == j) {
+                out.push(g.vertex_node(v));
+            }
+        }
+    }
+    out
+}
+
+fn anchor_dist(m: &Mesh, anchors: &[VertexId], a: u32, b: u32) -> f64 {
+    (m.position(anchors[a as usize]) - m.position(anchors[b as usize])).norm()
+}
+
+/// Builds the source layout on `t` (which must hold no paths yet).
+///
+/// # Errors
+/// `InputError::LayoutConflict` when the layout cannot be completed; `Cancelled`.
+pub fn source_layout(
+    t: &mut Tracer,
+    chi: i64,
+    opts: &LayoutOptions,
+    progress: &mut dyn Progress,
+) -> Result<(Clusters, LayoutStats)> {
+    let mesh = t.mesh();
+    let anchors = t.anchors().to_vec();
+    let cl = clusters(mesh, &anchors)?;
+    let mut stats = LayoutStats { cuts: cl.cuts.len(), ..Default::default() };
+    let mut order: Vec<usize> = (0..cl.cuts.len()).collect();
+    let multi = |c: usize| cl.between(cl.cuts[c].i, cl.cuts[c].j).count() > 1;
+    order.sort_by(|&x, &y| {
+        let (cx, cy) = (&cl.cuts[x], &cl.cuts[y]);
+        (multi(x), anchor_dist(mesh, &anchors, cx.i, cx.j))
+            .partial_cmp(&(multi(y), anchor_dist(mesh, &anchors, cy.i, cy.j)))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    for (k, &ci) in order.iter().enumerate() {
+        progress.check()?;
+        progress.report("layout_source", 0.8 * k as f64 / order.len().max(1) as f64);
+        let c = &cl.cuts[ci];
+        let mask = cl.mask(c.i, c.j);
+        let blocked = blocked_for_cut(t, &cl, ci);
+        let req = TraceRequest { a: c.i, b: c.j, faces: Some(&mask), blocked: &blocked, ..Default::default() };
+        match t.trace_insert(&req)? {
+            Some(_) => {
+                if multi(ci) {
+                    stats.multiple_linkages += 1;
+                }
+            }
+            None => stats.failed_traces += 1,
+        }
+    }
+    if std::env::var_os("SURFMAP_DEBUG").is_some() {
+        eprintln!("source cuts {} paths {} failed {}", cl.cuts.len(), t.paths().len(), stats.failed_traces);
+        for c in &cl.cuts {
+            eprintln!("  cut {}-{} edges {}", c.i, c.j, c.edges.len());
+        }
+    }
+    link_isolated(t, &mut stats)?;
+    let before = t.paths().len();
+    complete(&mut [t], chi, opts.max_attempts, progress)?;
+    stats.triangulation_paths = t.paths().len() - before;
+    stats.paths = t.paths().len();
+    Ok((cl, stats))
+}
+
+/// Links anchors that no cut path reached to their nearest reachable anchor.
+fn link_isolated(t: &mut Tracer, stats: &mut LayoutStats) -> Result<()> {
+    let na = t.anchors().len() as u32;
+    for a in 0..na {
+        if !t.rotation(a).is_empty() {
+            continue;
+        }
+        let anchors = t.anchors().to_vec();
+        let mut others: Vec<u32> = (0..na).filter(|&b| b != a).collect();
+        others
+            .sort_by(|&x, &y| anchor_dist(t.mesh(), &anchors, a, x).total_cmp(&anchor_dist(t.mesh(), &anchors, a, y)));
+        for b in others {
+            if t.trace_insert(&TraceRequest { a, b, ..Default::default() })?.is_some() {
+                stats.triangulation_paths += 1;
+                break;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The sector at anchor `x` for the source half `hs` (leaving `x`), given which source paths
+/// already exist on the target (`tid`), or `None` when `x` has no paths on the target yet.
+fn target_sector(src: &Tracer, tgt: &Tracer, tid: &[Option<u32>], x: u32, hs: Half) -> Option<Sector> {
+    let r = src.rotation(x);
+    let i = r.iter().position(|&(_, h)| h == hs)?;
+    let n = r.len();
+    let to_target = |h: Half| tid[(h / 2) as usize].map(|p| 2 * p + (h % 2));
+    for step in 1..n {
+        let (_, h) = r[(i + n - step) % n];
+        if let Some(th) = to_target(h) {
+            return tgt.sector_after(x, Some(th));
+        }
+    }
+    None
+}
+
+/// The present-path interval (predecessor, successor) around `hs` in the source rotation.
+fn present_interval(src: &Tracer, tid: &[Option<u32>], x: u32, hs: Half) -> (Option<Half>, Option<Half>) {
+    let r = src.rotation(x);
+    let Some(i) = r.iter().position(|&(_, h)| h == hs) else { return (None, None) };
+    let n = r.len();
+    let present = |h: Half| tid[(h / 2) as usize].is_some();
+    let pred = (1..n).map(|s| r[(i + n - s) % n].1).find(|&h| present(h));
+    let succ = (1..n).map(|s| r[(i + s) % n].1).find(|&h| present(h));
+    (pred, succ)
+}
+
+/// Builds the target layout as a copy of the source's on `tgt` (which must hold no paths),
+/// then renumbers its paths to the source's numbering.
+///
+/// # Errors
+/// `InputError::LayoutConflict` naming the first path that cannot be traced consistently.
+pub fn target_layout(
+    src: &Tracer,
+    tgt: &mut Tracer,
+    opts: &LayoutOptions,
+    progress: &mut dyn Progress,
+) -> Result<(Clusters, LayoutStats)> {
+    let anchors = tgt.anchors().to_vec();
+    let cl = clusters(tgt.mesh(), &anchors)?;
+    let np = src.paths().len();
+    let mut linkages = std::collections::HashMap::<(u32, u32), usize>::new();
+    for p in src.paths() {
+        *linkages.entry((p.a.min(p.b), p.a.max(p.b))).or_default() += 1;
+    }
+    let lk = |s: usize| linkages[&(src.paths()[s].a.min(src.paths()[s].b), src.paths()[s].a.max(src.paths()[s].b))];
+    // Groups: 0 = single linkage, one target cut; 1 = single linkage otherwise; 2 = multiple.
+    let group = |s: usize| {
+        let p = &src.paths()[s];
+        if lk(s) > 1 {
+            2
+        } else if cl.between(p.a, p.b).count() == 1 {
+            0
+        } else {
+            1
+        }
+    };
+    let mut queue: Vec<usize> = (0..np).collect();
+    queue.sort_by(|&x, &y| (group(x), src.paths()[x].length).partial_cmp(&(group(y), src.paths()[y].length)).unwrap());
+    let mut tid: Vec<Option<u32>> = vec![None; np];
+    let mut sid: Vec<u32> = Vec::with_capacity(np);
+    let mut stats = LayoutStats { cuts: cl.cuts.len(), ..Default::default() };
+    let mut attempts = 0usize;
+    let mut force = false;
+    while !queue.is_empty() {
+        progress.check()?;
+        progress.report("layout_target", sid.len() as f64 / np.max(1) as f64);
+        let mut progressed = false;
+        let mut postponed = Vec::new();
+        for &s in &queue {
+            let p = &src.paths()[s];
+            let (ha, hb) = (2 * s as Half, 2 * s as Half + 1);
+            if group(s) == 2 && !force {
+                // Postpone while another absent linkage of the pair shares this sector.
+                let ia = present_interval(src, &tid, p.a, ha);
+                let ambiguous = queue.iter().any(|&o| {
+                    o != s && tid[o].is_none() && {
+                        let q = &src.paths()[o];
+                        let ho = if q.a == p.a { 2 * o as Half } else { 2 * o as Half + 1 };
+                        (q.a.min(q.b), q.a.max(q.b)) == (p.a.min(p.b), p.a.max(p.b))
+                            && present_interval(src, &tid, p.a, ho) == ia
+                    }
+                });
+                if ambiguous {
+                    postponed.push(s);
+                    continue;
+                }
+            }
+            attempts += 1;
+            if attempts > opts.max_attempts {
+                return Err(InputError::LayoutConflict(format!(
+                    "gave up after {attempts} path searches on the target"
+                ))
+                .into());
+            }
+            let sector_a = target_sector(src, tgt, &tid, p.a, ha);
+            let sector_b = target_sector(src, tgt, &tid, p.b, hb);
+            let mask = (group(s) != 1).then(|| cl.mask(p.a, p.b));
+            let mut req = TraceRequest { a: p.a, b: p.b, faces: mask.as_deref(), sector_a, sector_b, blocked: &[] };
+            let mut got = tgt.trace(&req)?;
+            if got.is_none() && req.faces.is_some() {
+                req.faces = None;
+                attempts += 1;
+                got = tgt.trace(&req)?;
+            }
+            match got {
+                Some(path) => {
+                    let id = tgt.insert(path)?;
+                    tid[s] = Some(id);
+                    sid.push(s as u32);
+                    progressed = true;
+                    if group(s) == 2 {
+                        stats.multiple_linkages += 1;
+                    }
+                }
+                None => {
+                    stats.failed_traces += 1;
+                    postponed.push(s);
+                }
+            }
+        }
+        stats.postponed += postponed.len();
+        if !progressed {
+            if !force && !postponed.is_empty() {
+                force = true;
+                queue = postponed;
+                continue;
+            }
+            let s = postponed[0];
+            return Err(InputError::LayoutConflict(format!(
+                "the path between anchors {} and {} cannot be traced on the target without crossing others or breaking their cyclic order",
+                src.paths()[s].a,
+                src.paths()[s].b
+            ))
+            .into());
+        }
+        queue = postponed;
+    }
+    tgt.renumber(&sid)?;
+    // The rotation systems agree by construction; check it, and the walks, anyway.
+    let (ws, wt) = (walks(src), walks(tgt));
+    if ws != wt {
+        return Err(InputError::LayoutConflict("target regions differ from the source's".into()).into());
+    }
+    stats.paths = np;
+    Ok((cl, stats))
+}

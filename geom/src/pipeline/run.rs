@@ -1,0 +1,142 @@
+//! `run_map`: layout -> refinement -> patch parameterization -> composition -> smoothing ->
+//! metrics -> artifacts, with progress, cancellation and per-stage timings.
+
+use super::artifacts;
+use super::spec::{JobSpec, Method};
+use crate::crossparam::{compose, parameterize_patches, smooth};
+use crate::domain::tracer::Tracer;
+use crate::domain::{LayoutStats, greedy, patches_of, refine::refine, voronoi};
+use crate::error::{Error, Result};
+use crate::map::SurfaceMap;
+use crate::mesh::{Mesh, VertexId};
+use crate::metrics::{MapMetrics, MetricsOptions, evaluate_map};
+use crate::progress::Progress;
+use crate::topology;
+use serde::Serialize;
+use std::time::Instant;
+
+/// One output file: its name, media type and bytes.
+#[derive(Debug, Clone)]
+pub struct Artifact {
+    pub name: String,
+    pub content_type: &'static str,
+    pub bytes: Vec<u8>,
+}
+
+/// What a mapping job measured (also written as `metrics.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct MapReport {
+    pub method: &'static str,
+    pub anchors: usize,
+    pub patches: usize,
+    pub source_vertices: usize,
+    pub target_vertices: usize,
+    pub layout: LayoutStats,
+    pub source_to_target: MapMetrics,
+    pub target_to_source: MapMetrics,
+    /// Milliseconds per stage.
+    pub timings_ms: Vec<(String, f64)>,
+    pub smoothing: smooth::SmoothReport,
+}
+
+struct Clock(Instant, Vec<(String, f64)>);
+impl Clock {
+    fn lap(&mut self, stage: &str) {
+        let now = Instant::now();
+        self.1.push((stage.to_string(), (now - self.0).as_secs_f64() * 1e3));
+        self.0 = now;
+    }
+}
+
+/// The maps both ways, with what produced them.
+pub struct MapResult {
+    pub source_to_target: SurfaceMap,
+    pub target_to_source: SurfaceMap,
+}
+
+/// Runs a `voronoi` or `greedy` job.
+///
+/// # Errors
+/// Input errors for a spec that does not fit the meshes or anchors that admit no consistent
+/// layout; `Numerical` when a patch cannot be embedded; `Cancelled`.
+pub fn run_map(
+    spec: &JobSpec,
+    source: &Mesh,
+    target: &Mesh,
+    progress: &mut dyn Progress,
+) -> Result<(MapReport, Vec<Artifact>)> {
+    let mut clock = Clock(Instant::now(), Vec::new());
+    let pairs = spec.validate(source, target)?;
+    let o = &spec.options;
+    let chi = topology::euler_characteristic(source);
+    let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).collect();
+    let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).collect();
+    let mut st = Tracer::new(source, &sa, &o.layout.edge_nodes)?;
+    let mut tt = Tracer::new(target, &ta, &o.layout.edge_nodes)?;
+    clock.lap("setup");
+    progress.report("layout", 0.0);
+    let stats = match spec.method {
+        Method::Voronoi => {
+            let (_, mut s) = voronoi::source_layout(&mut st, chi, &o.layout, progress)?;
+            clock.lap("layout_source");
+            let (_, t) = voronoi::target_layout(&st, &mut tt, &o.layout, progress)?;
+            clock.lap("layout_target");
+            s.postponed = t.postponed;
+            s.failed_traces += t.failed_traces;
+            s
+        }
+        Method::Greedy => {
+            let s = greedy::greedy_layout(&mut st, &mut tt, chi, &o.layout, progress)?;
+            clock.lap("layout");
+            s
+        }
+    };
+    let patches = patches_of(&st);
+    let mut stats = stats;
+    stats.patches = patches.len();
+    progress.check()?;
+    let rs = refine(&st, &patches)?;
+    let rt = refine(&tt, &patches)?;
+    clock.lap("refine");
+    let ps = parameterize_patches(&rs, &patches, &sa, &o.param, progress)?;
+    let pt = parameterize_patches(&rt, &patches, &ta, &o.param, progress)?;
+    clock.lap("parameterize");
+    progress.report("compose", 0.0);
+    let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
+    let s2t = compose(&rs, &ps, source, &rt, &pt, target, &pairs, None);
+    let t2s = compose(&rt, &pt, target, &rs, &ps, source, &rev, None);
+    clock.lap("compose");
+    progress.check()?;
+    let (s2t, r1) = smooth::smooth(source, target, s2t, &sa, &o.smoothing, progress)?;
+    let (t2s, r2) = smooth::smooth(target, source, t2s, &ta, &o.smoothing, progress)?;
+    clock.lap("smooth");
+    let result = MapResult { source_to_target: s2t, target_to_source: t2s };
+    let on_target = result.source_to_target.embed(source, target)?;
+    let on_source = result.target_to_source.embed(target, source)?;
+    progress.report("metrics", 0.0);
+    let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
+    let m1 = evaluate_map(source, target, &on_target, Some(&pairs), None, &mo)?;
+    let m2 = evaluate_map(target, source, &on_source, Some(&rev), None, &mo)?;
+    clock.lap("metrics");
+    let mut report = MapReport {
+        method: spec.method.name(),
+        anchors: pairs.len(),
+        patches: patches.len(),
+        source_vertices: source.n_vertices(),
+        target_vertices: target.n_vertices(),
+        layout: stats,
+        source_to_target: m1,
+        target_to_source: m2,
+        timings_ms: Vec::new(),
+        smoothing: r1.merge(r2),
+    };
+    let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, &result, &on_target, &on_source)?;
+    clock.lap("artifacts");
+    let total: f64 = clock.1.iter().map(|x| x.1).sum();
+    clock.1.push(("total".into(), total));
+    report.timings_ms = clock.1;
+    let json = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal(e.to_string()))?;
+    arts.push(Artifact { name: "metrics.json".into(), content_type: "application/json", bytes: json });
+    progress.report("done", 1.0);
+    Ok((report, arts))
+}

@@ -1,0 +1,165 @@
+//! The job spec: the one description of a mapping job that the CLI (`surfmap map --spec`) and
+//! the server accept, validated here against the two meshes before any work starts.
+
+use crate::crossparam::PatchParamOptions;
+use crate::crossparam::smooth::SmoothOptions;
+use crate::domain::LayoutOptions;
+use crate::error::{InputError, Result};
+use crate::mesh::{Mesh, VertexId};
+use crate::topology;
+use serde::{Deserialize, Serialize};
+
+/// The mapping method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// Common base domains from Voronoi cues (Kwok, Zhang, Wang).
+    Voronoi,
+    /// The shortest-paths-first heuristic of Kraevoy & Sheffer 2004.
+    Greedy,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Voronoi => "voronoi",
+            Method::Greedy => "greedy",
+        }
+    }
+}
+
+/// Options of a `voronoi` or `greedy` job. Every field has a default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MapOptions {
+    /// Edge nodes and search budget of the layout construction.
+    pub layout: LayoutOptions,
+    /// Weights of the patch parameterization (mean value by default).
+    pub param: PatchParamOptions,
+    /// Stretch-reducing relocation of vertices across patch boundaries.
+    pub smoothing: SmoothOptions,
+    /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
+    pub metric_samples: usize,
+}
+
+impl Default for MapOptions {
+    fn default() -> Self {
+        Self {
+            layout: LayoutOptions::default(),
+            param: PatchParamOptions::default(),
+            smoothing: SmoothOptions::default(),
+            metric_samples: 100_000,
+        }
+    }
+}
+
+/// `{"method": ..., "anchors": [[s, t], ...], "options": {...}}`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JobSpec {
+    pub method: Method,
+    pub anchors: Vec<[u64; 2]>,
+    #[serde(default)]
+    pub options: MapOptions,
+}
+
+/// Most anchors a job may have.
+pub const MAX_ANCHORS: usize = 4096;
+
+impl JobSpec {
+    /// Parses a spec from JSON.
+    ///
+    /// # Errors
+    /// `InputError::Spec` naming the field at fault.
+    pub fn from_json(bytes: &[u8]) -> Result<JobSpec> {
+        serde_json::from_slice(bytes).map_err(|e| InputError::Spec(e.to_string()).into())
+    }
+
+    /// A spec from a bare anchors file `{"anchors": [[s, t], ...]}` or `[[s, t], ...]`.
+    ///
+    /// # Errors
+    /// `InputError::Spec` when the JSON has neither form.
+    pub fn from_anchors_json(bytes: &[u8], method: Method) -> Result<JobSpec> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum A {
+            Obj { anchors: Vec<[u64; 2]> },
+            List(Vec<[u64; 2]>),
+        }
+        let a: A = serde_json::from_slice(bytes).map_err(|e| InputError::Spec(format!("anchors file: {e}")))?;
+        let anchors = match a {
+            A::Obj { anchors } | A::List(anchors) => anchors,
+        };
+        Ok(JobSpec { method, anchors, options: MapOptions::default() })
+    }
+
+    /// Checks the spec against the meshes: same genus, closed surfaces, anchors in range and
+    /// distinct, enough anchors. Returns the anchors as vertex pairs.
+    ///
+    /// # Errors
+    /// `InputError::TopologyMismatch`, `InputError::Anchors`.
+    pub fn validate(&self, source: &Mesh, target: &Mesh) -> Result<Vec<(VertexId, VertexId)>> {
+        let (ss, ts) = (topology::summary(source), topology::summary(target));
+        if ss.components != 1 || ts.components != 1 {
+            return Err(InputError::TopologyMismatch(format!(
+                "both meshes must be connected (source has {} components, target {})",
+                ss.components, ts.components
+            ))
+            .into());
+        }
+        if ss.genus != ts.genus {
+            return Err(InputError::TopologyMismatch(format!(
+                "genus mismatch: source has genus {}, target genus {}",
+                ss.genus, ts.genus
+            ))
+            .into());
+        }
+        if ss.boundary_loops != 0 || ts.boundary_loops != 0 {
+            return Err(InputError::TopologyMismatch(format!(
+                "method {} maps closed surfaces; source has {} boundary loops, target {}",
+                self.method.name(),
+                ss.boundary_loops,
+                ts.boundary_loops
+            ))
+            .into());
+        }
+        let n = self.anchors.len();
+        if n > MAX_ANCHORS {
+            return Err(InputError::Anchors(format!("{n} anchors exceed the limit {MAX_ANCHORS}")).into());
+        }
+        let need = if ss.genus == 0 { 3 } else { 6 };
+        if n < need {
+            return Err(InputError::Anchors(format!(
+                "too few anchors: {n} given, a genus-{} layout needs at least {need}",
+                ss.genus
+            ))
+            .into());
+        }
+        let mut out = Vec::with_capacity(n);
+        let (mut seen_s, mut seen_t) = (std::collections::HashMap::new(), std::collections::HashMap::new());
+        for (i, &[s, t]) in self.anchors.iter().enumerate() {
+            if s >= source.n_vertices() as u64 {
+                return Err(InputError::Anchors(format!(
+                    "anchor {i}: source vertex {s} is out of range (source has {} vertices)",
+                    source.n_vertices()
+                ))
+                .into());
+            }
+            if t >= target.n_vertices() as u64 {
+                return Err(InputError::Anchors(format!(
+                    "anchor {i}: target vertex {t} is out of range (target has {} vertices)",
+                    target.n_vertices()
+                ))
+                .into());
+            }
+            if let Some(j) = seen_s.insert(s, i) {
+                return Err(InputError::Anchors(format!("anchors {j} and {i} repeat source vertex {s}")).into());
+            }
+            if let Some(j) = seen_t.insert(t, i) {
+                return Err(InputError::Anchors(format!("anchors {j} and {i} repeat target vertex {t}")).into());
+            }
+            out.push((VertexId(s as u32), VertexId(t as u32)));
+        }
+        Ok(out)
+    }
+}

@@ -33,6 +33,7 @@ impl Default for SmoothOptions {
 /// What smoothing did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct SmoothReport {
+    pub untangled: usize,
     pub moves: usize,
     pub rejected: usize,
     pub energy_before: f64,
@@ -42,6 +43,7 @@ pub struct SmoothReport {
 impl SmoothReport {
     pub fn merge(self, o: SmoothReport) -> SmoothReport {
         SmoothReport {
+            untangled: self.untangled + o.untangled,
             moves: self.moves + o.moves,
             rejected: self.rejected + o.rejected,
             energy_before: self.energy_before + o.energy_before,
@@ -136,6 +138,55 @@ pub fn smooth(
             .sum::<f64>()
             + 0.0 * img_face.len() as f64
     };
+    // Untangle first: a vertex of a face that faces against the target at all its corners
+    // moves towards its neighbours' images if that lowers the number of such faces.
+    let flipped_at = |v: VertexId, pos: &[P3], img_face: &[FaceId], p: P3, f: FaceId| -> usize {
+        source
+            .outgoing(v)
+            .filter(|h| {
+                let tri = source.face(h.face());
+                let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
+                let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+                tri.iter().all(|&w| nm.dot(&tnormal(if w == v { f } else { img_face[w.idx()] })) < 0.0)
+            })
+            .count()
+    };
+    for _ in 0..opts.iterations {
+        let mut changed = false;
+        for vi in 0..n {
+            if is_fixed[vi] {
+                continue;
+            }
+            let v = VertexId::from_idx(vi);
+            let cur = flipped_at(v, &pos, &img_face, pos[vi], img_face[vi]);
+            if cur == 0 {
+                continue;
+            }
+            let (mut c, mut k) = (V3::zeros(), 0.0f64);
+            for w in source.vertex_neighbors(v) {
+                c += pos[w.idx()].coords;
+                k += 1.0;
+            }
+            let goal = P3::from(c / k.max(1.0));
+            let mut step = 1.0;
+            for _ in 0..4 {
+                let pr = loc.project(&P3::from(pos[vi].coords + (goal - pos[vi]) * step));
+                if flipped_at(v, &pos, &img_face, pr.point, pr.face) < cur {
+                    pos[vi] = pr.point;
+                    img_face[vi] = pr.face;
+                    map.face[vi] = pr.face;
+                    map.bary[vi] = pr.bary;
+                    rep.untangled += 1;
+                    changed = true;
+                    break;
+                }
+                step *= 0.5;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
     rep.energy_before = total(&pos, &img_face);
     for it in 0..opts.iterations {
         progress.check()?;

@@ -61,11 +61,13 @@ pub struct LayoutOptions {
     pub edge_nodes: crate::geodesic::EdgeNodeOptions,
     /// Upper bound on paths tried while triangulating or repairing, against endless searches.
     pub max_attempts: usize,
+    /// Rebuilds with twice the minimal edge-node count (minus one) after a failed layout.
+    pub rebuilds: u32,
 }
 
 impl Default for LayoutOptions {
     fn default() -> Self {
-        Self { edge_nodes: Default::default(), max_attempts: 20_000 }
+        Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 2 }
     }
 }
 
@@ -88,6 +90,9 @@ pub struct LayoutStats {
     pub triangulation_paths: usize,
     pub postponed: usize,
     pub failed_traces: usize,
+    /// Layout rebuilds at higher edge-node density, and the density finally used.
+    pub rebuilds: u32,
+    pub edge_nodes_min: u32,
 }
 
 /// Patches from the walks of a complete layout.

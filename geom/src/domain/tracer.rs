@@ -41,6 +41,8 @@ pub struct Tracer<'m> {
     anchor_of: Vec<u32>,
     used: Vec<bool>,
     tmp_block: Vec<bool>,
+    /// Ring nodes next (in ring order) to a used ring node of the traced path's anchors.
+    near: Vec<bool>,
     chords: Vec<Vec<(u32, u32)>>,
     paths: Vec<LayoutPath>,
     /// Per anchor: (ring key, half leaving the anchor), sorted by key.
@@ -49,15 +51,19 @@ pub struct Tracer<'m> {
     ring_owner: Vec<u32>,
     /// Per anchor: its ring nodes sorted by key.
     rings: Vec<Vec<(NodeId, u32)>>,
+    opts: EdgeNodeOptions,
 }
 
 struct Filter<'a, 't> {
     t: &'a Tracer<'t>,
     faces: Option<&'a [bool]>,
     ends: [u32; 2],
-    /// Keep one free node between the new path and existing ones along every edge.
-    gap: bool,
 }
+
+/// Arc-length factor for stepping next to an existing path (along an edge, or beside one at
+/// an anchor): paths keep a free node between them where they can, so that no region between
+/// two paths is left without nodes to pass through, yet may touch where they must.
+const CLEARANCE_PENALTY: f64 = 4.0;
 
 impl Filter<'_, '_> {
     fn next_to_used(&self, n: NodeId) -> bool {
@@ -79,12 +85,7 @@ impl Filter<'_, '_> {
 impl SearchFilter for Filter<'_, '_> {
     fn node_ok(&self, n: NodeId) -> bool {
         let i = n.0 as usize;
-        let owner = self.t.ring_owner[i];
-        !self.t.used[i]
-            && !self.t.tmp_block[i]
-            && (i >= self.t.anchor_of.len() || self.t.anchor_of[i] == u32::MAX)
-            && (owner >= u32::MAX - 1 || owner == self.ends[0] || owner == self.ends[1])
-            && !(self.gap && self.next_to_used(n))
+        !self.t.used[i] && !self.t.tmp_block[i] && (i >= self.t.anchor_of.len() || self.t.anchor_of[i] == u32::MAX)
     }
     fn face_ok(&self, f: FaceId) -> bool {
         self.faces.is_none_or(|m| m[f.idx()])
@@ -99,6 +100,17 @@ impl SearchFilter for Filter<'_, '_> {
             return false;
         };
         !ch.iter().any(|&(a, b)| crosses((a, b), (p, q)))
+    }
+    fn penalty(&self, n: NodeId) -> f64 {
+        let owner = self.t.ring_owner[n.0 as usize];
+        if owner < u32::MAX - 1 && owner != self.ends[0] && owner != self.ends[1] {
+            // Passing right next to another anchor crowds its sectors.
+            CLEARANCE_PENALTY
+        } else if self.t.near[n.0 as usize] || self.next_to_used(n) {
+            CLEARANCE_PENALTY
+        } else {
+            1.0
+        }
     }
 }
 
@@ -155,14 +167,20 @@ impl<'m> Tracer<'m> {
             anchor_of,
             used: vec![false; nn],
             tmp_block: vec![false; nn],
+            near: vec![false; nn],
             chords: vec![Vec::new(); mesh.n_faces()],
             paths: Vec::new(),
             rot: vec![Vec::new(); anchors.len()],
             ring_owner,
             rings,
+            opts: *opts,
         })
     }
 
+    /// The edge-node options the graph was built with.
+    pub fn edge_node_options(&self) -> EdgeNodeOptions {
+        self.opts
+    }
     pub fn graph(&self) -> &EdgeNodeGraph<'m> {
         &self.graph
     }
@@ -201,16 +219,12 @@ impl<'m> Tracer<'m> {
         if req.a >= na || req.b >= na || req.a == req.b {
             return Err(InputError::Anchors(format!("cannot link anchors {} and {}", req.a, req.b)).into());
         }
-        // First keep a free ring node on both sides of every path at the two anchors, so no
-        // sector between paths is left without a way out; then without that margin.
-        match self.trace_once(req, true)? {
-            Some(p) => Ok(Some(p)),
-            None => self.trace_once(req, false),
-        }
+        self.trace_once(req)
     }
 
-    fn trace_once(&mut self, req: &TraceRequest, gap: bool) -> Result<Option<LayoutPath>> {
+    fn trace_once(&mut self, req: &TraceRequest) -> Result<Option<LayoutPath>> {
         let mut marked: Vec<NodeId> = req.blocked.to_vec();
+        let mut near: Vec<NodeId> = Vec::new();
         for (anchor, sector) in [(req.a, req.sector_a), (req.b, req.sector_b)] {
             let ring = &self.rings[anchor as usize];
             if let Some(s) = sector {
@@ -220,28 +234,29 @@ impl<'m> Tracer<'m> {
                     }
                 }
             }
-            if gap && !self.rot[anchor as usize].is_empty() {
-                let k = ring.len();
-                for (i, &(n, _)) in ring.iter().enumerate() {
-                    if self.used[n.0 as usize] {
-                        marked.push(ring[(i + 1) % k].0);
-                        marked.push(ring[(i + k - 1) % k].0);
-                    }
+            let k = ring.len();
+            for (i, &(n, _)) in ring.iter().enumerate() {
+                if self.used[n.0 as usize] {
+                    near.push(ring[(i + 1) % k].0);
+                    near.push(ring[(i + k - 1) % k].0);
                 }
             }
+        }
+        for n in &near {
+            self.near[n.0 as usize] = true;
         }
         for n in &marked {
             self.tmp_block[n.0 as usize] = true;
         }
         let from = self.graph.vertex_node(self.anchors[req.a as usize]);
         let to = self.graph.vertex_node(self.anchors[req.b as usize]);
-        let found = self.graph.shortest_path_filtered(
-            from,
-            to,
-            &Filter { t: self, faces: req.faces, ends: [req.a, req.b], gap },
-        );
+        let found =
+            self.graph.shortest_path_filtered(from, to, &Filter { t: self, faces: req.faces, ends: [req.a, req.b] });
         for n in &marked {
             self.tmp_block[n.0 as usize] = false;
+        }
+        for n in &near {
+            self.near[n.0 as usize] = false;
         }
         Ok(found?.map(|p| LayoutPath { a: req.a, b: req.b, nodes: p.nodes, points: p.points, length: p.length }))
     }

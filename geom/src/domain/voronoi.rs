@@ -170,8 +170,9 @@ pub fn target_layout(
     src: &Tracer,
     tgt: &mut Tracer,
     opts: &LayoutOptions,
+    priority: &[usize],
     progress: &mut dyn Progress,
-) -> Result<(Clusters, LayoutStats)> {
+) -> Result<std::result::Result<LayoutStats, usize>> {
     let anchors = tgt.anchors().to_vec();
     let cl = clusters(tgt.mesh(), &anchors)?;
     let np = src.paths().len();
@@ -192,7 +193,12 @@ pub fn target_layout(
         }
     };
     let mut queue: Vec<usize> = (0..np).collect();
-    queue.sort_by(|&x, &y| (group(x), src.paths()[x].length).partial_cmp(&(group(y), src.paths()[y].length)).unwrap());
+    let rank = |s: usize| priority.iter().position(|&p| p == s).unwrap_or(usize::MAX);
+    queue.sort_by(|&x, &y| {
+        (rank(x), group(x), src.paths()[x].length)
+            .partial_cmp(&(rank(y), group(y), src.paths()[y].length))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
     let mut tid: Vec<Option<u32>> = vec![None; np];
     let mut sid: Vec<u32> = Vec::with_capacity(np);
     let mut stats = LayoutStats { cuts: cl.cuts.len(), ..Default::default() };
@@ -263,12 +269,40 @@ pub fn target_layout(
                 continue;
             }
             let s = postponed[0];
-            return Err(InputError::LayoutConflict(format!(
-                "the path between anchors {} and {} cannot be traced on the target without crossing others or breaking their cyclic order",
-                src.paths()[s].a,
-                src.paths()[s].b
-            ))
-            .into());
+            if std::env::var_os("SURFMAP_DEBUG").is_some() {
+                for &s in &postponed {
+                    let p = &src.paths()[s];
+                    let free = tgt.trace(&TraceRequest { a: p.a, b: p.b, ..Default::default() })?.is_some();
+                    let sa = target_sector(src, tgt, &tid, p.a, 2 * s as Half);
+                    let sb = target_sector(src, tgt, &tid, p.b, 2 * s as Half + 1);
+                    let only_a =
+                        tgt.trace(&TraceRequest { a: p.a, b: p.b, sector_a: sa, ..Default::default() })?.is_some();
+                    let only_b =
+                        tgt.trace(&TraceRequest { a: p.a, b: p.b, sector_b: sb, ..Default::default() })?.is_some();
+                    eprintln!(
+                        "target path {s} {}-{} group {} free {free} only_a {only_a} only_b {only_b} placed {}/{np}",
+                        p.a,
+                        p.b,
+                        group(s),
+                        sid.len()
+                    );
+                    for w in walks(tgt) {
+                        if !w.is_triangle(tgt) {
+                            eprintln!("  open walk {:?} halves {:?}", w.corners(tgt), w.halves);
+                        }
+                    }
+                    let r = super::refine::refine(tgt, &super::patches_of(tgt));
+                    eprintln!("  refine: {:?}", r.as_ref().err());
+                    if let Ok(r) = r {
+                        let mut cnt = std::collections::HashMap::new();
+                        for &p in &r.patch {
+                            *cnt.entry(p).or_insert(0) += 1;
+                        }
+                        eprintln!("  labelled regions {} of {} walks", cnt.len(), walks(tgt).len());
+                    }
+                }
+            }
+            return Ok(Err(s));
         }
         queue = postponed;
     }
@@ -279,5 +313,39 @@ pub fn target_layout(
         return Err(InputError::LayoutConflict("target regions differ from the source's".into()).into());
     }
     stats.paths = np;
-    Ok((cl, stats))
+    Ok(Ok(stats))
+}
+
+/// [`target_layout`], restarted with each path that could not be traced moved to the front
+/// (a rip-up-and-reroute of the whole target), at most `restarts` times.
+///
+/// # Errors
+/// `InputError::LayoutConflict` naming the path that still cannot be traced.
+pub fn target_layout_with_restarts<'m>(
+    src: &Tracer,
+    tgt: &mut Tracer<'m>,
+    opts: &LayoutOptions,
+    restarts: usize,
+    progress: &mut dyn Progress,
+) -> Result<LayoutStats> {
+    let mut priority: Vec<usize> = Vec::new();
+    loop {
+        let mut fresh = Tracer::new(tgt.mesh(), tgt.anchors(), &tgt.edge_node_options())?;
+        match target_layout(src, &mut fresh, opts, &priority, progress)? {
+            Ok(mut s) => {
+                s.postponed += priority.len();
+                *tgt = fresh;
+                return Ok(s);
+            }
+            Err(s) if priority.len() < restarts && !priority.contains(&s) => priority.insert(0, s),
+            Err(s) => {
+                return Err(InputError::LayoutConflict(format!(
+                    "the path between anchors {} and {} cannot be traced on the target without crossing others or breaking their cyclic order",
+                    src.paths()[s].a,
+                    src.paths()[s].b
+                ))
+                .into());
+            }
+        }
+    }
 }

@@ -314,7 +314,7 @@ impl<'m> EdgeNodeGraph<'m> {
                 if s.done[wi] {
                     return;
                 }
-                let nd = du + (self.pos[wi] - pu).norm();
+                let nd = du + (self.pos[wi] - pu).norm() * filter.penalty(w);
                 if nd < s.dist[wi] && filter.arc_ok(face, NodeId(u), w) {
                     s.dist[wi] = nd;
                     s.pred[wi] = u;
@@ -414,6 +414,10 @@ pub trait SearchFilter {
     /// May the search use the arc `from -> to`, which crosses `face` (`None`: along an edge)?
     fn arc_ok(&self, _face: Option<FaceId>, _from: NodeId, _to: NodeId) -> bool {
         true
+    }
+    /// Length multiplier (at least 1) of arcs entering node `n`: a soft preference.
+    fn penalty(&self, _n: NodeId) -> f64 {
+        1.0
     }
 }
 

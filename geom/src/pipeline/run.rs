@@ -6,7 +6,7 @@ use super::spec::{JobSpec, Method};
 use crate::crossparam::{compose, parameterize_patches, smooth};
 use crate::domain::tracer::Tracer;
 use crate::domain::{LayoutStats, greedy, patches_of, refine::refine, voronoi};
-use crate::error::{Error, Result};
+use crate::error::{Error, InputError, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
 use crate::metrics::{MapMetrics, MetricsOptions, evaluate_map};
@@ -71,26 +71,42 @@ pub fn run_map(
     let chi = topology::euler_characteristic(source);
     let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).collect();
     let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).collect();
-    let mut st = Tracer::new(source, &sa, &o.layout.edge_nodes)?;
-    let mut tt = Tracer::new(target, &ta, &o.layout.edge_nodes)?;
     clock.lap("setup");
     progress.report("layout", 0.0);
-    let stats = match spec.method {
-        Method::Voronoi => {
-            let (_, mut s) = voronoi::source_layout(&mut st, chi, &o.layout, progress)?;
-            clock.lap("layout_source");
-            let (_, t) = voronoi::target_layout(&st, &mut tt, &o.layout, progress)?;
-            clock.lap("layout_target");
-            s.postponed = t.postponed;
-            s.failed_traces += t.failed_traces;
-            s
-        }
-        Method::Greedy => {
-            let s = greedy::greedy_layout(&mut st, &mut tt, chi, &o.layout, progress)?;
-            clock.lap("layout");
-            s
+    // Denser edge nodes leave more room between paths; a layout that cannot be completed at
+    // the requested density is rebuilt at higher ones before giving up.
+    let mut edge_nodes = o.layout.edge_nodes;
+    let mut attempt = 0;
+    let (st, tt, stats) = loop {
+        let mut st = Tracer::new(source, &sa, &edge_nodes)?;
+        let mut tt = Tracer::new(target, &ta, &edge_nodes)?;
+        let built = match spec.method {
+            Method::Voronoi => voronoi::source_layout(&mut st, chi, &o.layout, progress).and_then(|(_, mut s)| {
+                let t = voronoi::target_layout_with_restarts(&st, &mut tt, &o.layout, 8, progress)?;
+                s.postponed = t.postponed;
+                s.failed_traces += t.failed_traces;
+                Ok(s)
+            }),
+            Method::Greedy => greedy::greedy_layout(&mut st, &mut tt, chi, &o.layout, progress),
+        };
+        match built {
+            Ok(mut s) => {
+                s.rebuilds = attempt;
+                s.edge_nodes_min = edge_nodes.min_nodes;
+                break (st, tt, s);
+            }
+            Err(Error::Input(InputError::LayoutConflict(m))) if attempt < o.layout.rebuilds => {
+                if std::env::var_os("SURFMAP_DEBUG").is_some() {
+                    eprintln!("rebuild after: {m}");
+                }
+                attempt += 1;
+                edge_nodes.min_nodes = edge_nodes.min_nodes * 2 - 1;
+                edge_nodes.max_nodes = edge_nodes.max_nodes.max(edge_nodes.min_nodes);
+            }
+            Err(e) => return Err(e),
         }
     };
+    clock.lap("layout");
     let patches = patches_of(&st);
     let mut stats = stats;
     stats.patches = patches.len();

@@ -40,6 +40,7 @@ pub fn locate_in(rb: &Refined, b: &Mesh, pb: &[PatchParam], patch: u32, uv: Uv) 
 }
 
 /// The map from A's original vertices to B's surface. Anchors go exactly to their partners.
+#[allow(clippy::too_many_arguments)]
 pub fn compose(
     ra: &Refined,
     pa: &[PatchParam],

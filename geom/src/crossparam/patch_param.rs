@@ -95,7 +95,7 @@ pub fn parameterize_patches(
         let mut lp = disk_boundary(&local).map_err(|e| Error::Numerical(format!("patch {pi}: {e}")))?;
         let corner_local = |a: u32| {
             let v = anchors[a as usize];
-            global_v.iter().position(|&g| g == v).map(|i| VertexId::from_idx(i))
+            global_v.iter().position(|&g| g == v).map(VertexId::from_idx)
         };
         let c = patch.corners.map(corner_local);
         let [Some(c0), Some(c1), Some(c2)] = c else {

@@ -136,7 +136,8 @@ pub fn complete(
         if na - t0.paths().len() as i64 + ws.len() as i64 == chi {
             return Ok(stats);
         }
-        let mut cand: Vec<(f64, (usize, usize), (usize, usize))> = Vec::new();
+        type End = (usize, usize);
+        let mut cand: Vec<(f64, End, End)> = Vec::new();
         for (wi, w) in ws.iter().enumerate() {
             for (wj, x) in ws.iter().enumerate().skip(wi + 1) {
                 for (ci, &a) in w.corners(t0).iter().enumerate() {

@@ -100,9 +100,9 @@ pub fn refine(t: &Tracer, patches: &[Patch]) -> Result<Refined> {
         }
         // Boundary positions of the face: corners and used edge nodes, in cyclic order.
         let mut ring: Vec<(u32, u32)> = Vec::new();
-        for k in 0..3 {
+        for (k, corner) in tri.iter().enumerate() {
             let h = HalfedgeId::of(fid, k);
-            ring.push(((k as u32) << 16, tri[k].0));
+            ring.push(((k as u32) << 16, corner.0));
             let e = mesh.edge(h);
             let mut side: Vec<(u32, u32)> = (0..g.edge_node_count(e))
                 .filter_map(|i| {

@@ -382,7 +382,7 @@ impl<'m> Tracer<'m> {
     /// Anchor a half leaves.
     pub fn half_start(&self, h: Half) -> u32 {
         let p = &self.paths[(h / 2) as usize];
-        if h % 2 == 0 { p.a } else { p.b }
+        if h.is_multiple_of(2) { p.a } else { p.b }
     }
     /// Anchor a half reaches.
     pub fn half_end(&self, h: Half) -> u32 {

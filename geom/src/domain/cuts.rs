@@ -4,7 +4,7 @@
 
 use crate::error::Result;
 use crate::geodesic::{FaceVoronoiOptions, face_voronoi};
-use crate::mesh::{EdgeId, Mesh, VertexId};
+use crate::mesh::{EdgeId, FaceId, Mesh, VertexId};
 use std::collections::HashMap;
 
 /// One cut between clusters `i < j`.
@@ -22,6 +22,8 @@ pub struct Clusters {
     /// Anchor index per face.
     pub label: Vec<u32>,
     pub cuts: Vec<Cut>,
+    /// Faces of each cluster.
+    pub faces: Vec<Vec<FaceId>>,
 }
 
 impl Clusters {
@@ -90,7 +92,13 @@ pub fn clusters(mesh: &Mesh, anchors: &[VertexId]) -> Result<Clusters> {
             cuts.push(Cut { i, j, edges: g, vertices });
         }
     }
-    Ok(Clusters { label, cuts })
+    let mut faces = vec![Vec::new(); anchors.len()];
+    for (f, &l) in label.iter().enumerate() {
+        if let Some(v) = faces.get_mut(l as usize) {
+            v.push(FaceId::from_idx(f));
+        }
+    }
+    Ok(Clusters { label, cuts, faces })
 }
 
 #[cfg(test)]

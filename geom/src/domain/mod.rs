@@ -9,6 +9,7 @@ pub mod complete;
 pub mod cuts;
 pub mod greedy;
 pub mod refine;
+pub mod straighten;
 pub mod tracer;
 pub mod voronoi;
 pub mod walks;
@@ -63,11 +64,13 @@ pub struct LayoutOptions {
     pub max_attempts: usize,
     /// Rebuilds with twice the minimal edge-node count (minus one) after a failed layout.
     pub rebuilds: u32,
+    /// Rounds of path straightening on both meshes after the layout is built (0: none).
+    pub straighten_rounds: usize,
 }
 
 impl Default for LayoutOptions {
     fn default() -> Self {
-        Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 2 }
+        Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 2, straighten_rounds: 2 }
     }
 }
 
@@ -93,6 +96,8 @@ pub struct LayoutStats {
     /// Layout rebuilds at higher edge-node density, and the density finally used.
     pub rebuilds: u32,
     pub edge_nodes_min: u32,
+    /// Paths shortened by straightening (both meshes).
+    pub straightened: usize,
 }
 
 /// Patches from the walks of a complete layout.

@@ -148,7 +148,18 @@ impl<'m> Tracer<'m> {
             }
             anchor_of[a.idx()] = i as u32;
         }
-        let graph = EdgeNodeGraph::new(mesh, opts);
+        // An anchor's ring must hold a free node between any two of its paths, and anchors can
+        // carry a dozen paths: the edges of anchor stars (and their opposite edges) get three
+        // times the minimal node count.
+        let mut boost = vec![false; mesh.n_edges()];
+        for a in anchors {
+            for h in mesh.outgoing(*a) {
+                boost[mesh.edge(h).idx()] = true;
+                boost[mesh.edge(h.next()).idx()] = true;
+            }
+        }
+        let ring_min = 3 * opts.min_nodes.max(1);
+        let graph = EdgeNodeGraph::with_minimum(mesh, opts, &|e| if boost[e.idx()] { ring_min } else { 0 });
         let nn = graph.n_nodes();
         let mut ring_owner = vec![u32::MAX; nn];
         let mut rings = Vec::with_capacity(anchors.len());
@@ -219,10 +230,10 @@ impl<'m> Tracer<'m> {
         if req.a >= na || req.b >= na || req.a == req.b {
             return Err(InputError::Anchors(format!("cannot link anchors {} and {}", req.a, req.b)).into());
         }
-        self.trace_once(req)
+        self.trace_once(req, false)
     }
 
-    fn trace_once(&mut self, req: &TraceRequest) -> Result<Option<LayoutPath>> {
+    fn trace_once(&mut self, req: &TraceRequest, hard_gap: bool) -> Result<Option<LayoutPath>> {
         let mut marked: Vec<NodeId> = req.blocked.to_vec();
         let mut near: Vec<NodeId> = Vec::new();
         for (anchor, sector) in [(req.a, req.sector_a), (req.b, req.sector_b)] {
@@ -242,6 +253,10 @@ impl<'m> Tracer<'m> {
                 }
             }
         }
+        if hard_gap {
+            marked.extend_from_slice(&near);
+            near.clear();
+        }
         for n in &near {
             self.near[n.0 as usize] = true;
         }
@@ -258,7 +273,12 @@ impl<'m> Tracer<'m> {
         for n in &near {
             self.near[n.0 as usize] = false;
         }
-        Ok(found?.map(|p| LayoutPath { a: req.a, b: req.b, nodes: p.nodes, points: p.points, length: p.length }))
+        let m = self.graph.mesh();
+        Ok(found?.map(|p| {
+            // The search length includes clearance penalties; report the geometric one.
+            let length = p.points.windows(2).map(|w| (w[1].position(m) - w[0].position(m)).norm()).sum();
+            LayoutPath { a: req.a, b: req.b, nodes: p.nodes, points: p.points, length }
+        }))
     }
 
     /// Traces and inserts; returns the new path's index.
@@ -279,10 +299,22 @@ impl<'m> Tracer<'m> {
     /// `Error::Internal` if the path is not a valid chain of arcs.
     pub fn insert(&mut self, p: LayoutPath) -> Result<u32> {
         let id = self.paths.len() as u32;
+        self.place(id, &p)?;
+        self.paths.push(p);
+        Ok(id)
+    }
+
+    /// Records path `p` as path `id`: chords, used nodes, rotation entries.
+    fn place(&mut self, id: u32, p: &LayoutPath) -> Result<()> {
         let k = p.nodes.len();
         if k < 3 {
             return Err(Error::Internal(format!("path of {k} nodes")));
         }
+        let va = self.anchors[p.a as usize];
+        let vb = self.anchors[p.b as usize];
+        let ka = self.graph.ring_key(va, p.nodes[1]).ok_or_else(|| Error::Internal("path leaves its anchor".into()))?;
+        let kb =
+            self.graph.ring_key(vb, p.nodes[k - 2]).ok_or_else(|| Error::Internal("path enters its anchor".into()))?;
         for w in p.nodes.windows(2) {
             if let Some((f, pa, pb)) = self.arc_face(w[0], w[1]) {
                 self.chords[f.idx()].push((pa.min(pb), pa.max(pb)));
@@ -291,18 +323,77 @@ impl<'m> Tracer<'m> {
         for n in &p.nodes[1..k - 1] {
             self.used[n.0 as usize] = true;
         }
-        let va = self.anchors[p.a as usize];
-        let vb = self.anchors[p.b as usize];
-        let ka = self.graph.ring_key(va, p.nodes[1]).ok_or_else(|| Error::Internal("path leaves its anchor".into()))?;
-        let kb =
-            self.graph.ring_key(vb, p.nodes[k - 2]).ok_or_else(|| Error::Internal("path enters its anchor".into()))?;
         for (anchor, key, half) in [(p.a, ka, 2 * id), (p.b, kb, 2 * id + 1)] {
             let r = &mut self.rot[anchor as usize];
             let pos = r.partition_point(|&(k2, _)| k2 < key);
             r.insert(pos, (key, half));
         }
-        self.paths.push(p);
-        Ok(id)
+        Ok(())
+    }
+
+    /// Removes path `id` from the surface (chords, nodes, rotations) but keeps its record, and
+    /// returns the sectors it occupied at its two ends (between its rotation neighbours).
+    fn lift(&mut self, id: u32) -> (Option<Sector>, Option<Sector>) {
+        let p = self.paths[id as usize].clone();
+        let k = p.nodes.len();
+        for w in p.nodes.windows(2) {
+            if let Some((f, pa, pb)) = self.arc_face(w[0], w[1]) {
+                let c = (pa.min(pb), pa.max(pb));
+                let ch = &mut self.chords[f.idx()];
+                if let Some(i) = ch.iter().position(|&x| x == c) {
+                    ch.swap_remove(i);
+                }
+            }
+        }
+        for n in &p.nodes[1..k - 1] {
+            self.used[n.0 as usize] = false;
+        }
+        let mut sectors = [None, None];
+        for (i, (anchor, half)) in [(p.a, 2 * id), (p.b, 2 * id + 1)].into_iter().enumerate() {
+            let r = &mut self.rot[anchor as usize];
+            if let Some(pos) = r.iter().position(|&(_, h)| h == half) {
+                r.remove(pos);
+            }
+            sectors[i] = self.sector_around_removed(anchor, &p, i);
+        }
+        (sectors[0], sectors[1])
+    }
+
+    /// After a lift: the sector at the `i`-th end of `p` between the remaining paths around the
+    /// ring key where `p` left.
+    fn sector_around_removed(&self, anchor: u32, p: &LayoutPath, i: usize) -> Option<Sector> {
+        let r = &self.rot[anchor as usize];
+        if r.is_empty() {
+            return None;
+        }
+        let first = if i == 0 { p.nodes[1] } else { p.nodes[p.nodes.len() - 2] };
+        let key = self.graph.ring_key(self.anchors[anchor as usize], first)?;
+        let pos = r.partition_point(|&(k2, _)| k2 < key);
+        let n = r.len();
+        Some(Sector { from: r[(pos + n - 1) % n].0, to: r[pos % n].0 })
+    }
+
+    /// Re-traces path `id` as the shortest path in the same sectors at both ends (so within the
+    /// two regions beside it); keeps the old path when no shorter one is found.
+    ///
+    /// # Errors
+    /// `Error::Internal` if the old path cannot be put back.
+    pub fn retrace(&mut self, id: u32) -> Result<bool> {
+        let old = self.paths[id as usize].clone();
+        let (sector_a, sector_b) = self.lift(id);
+        let req = TraceRequest { a: old.a, b: old.b, sector_a, sector_b, ..Default::default() };
+        let new = self.trace_once(&req, false)?;
+        match new {
+            Some(p) if p.length < old.length * (1.0 - 1e-9) => {
+                self.place(id, &p)?;
+                self.paths[id as usize] = p;
+                Ok(true)
+            }
+            _ => {
+                self.place(id, &old)?;
+                Ok(false)
+            }
+        }
     }
 
     /// The face an arc crosses and the cyclic positions of its ends, or `None` for an arc along

@@ -21,7 +21,7 @@ use super::walks::walks;
 use super::{LayoutOptions, LayoutStats, Sector};
 use crate::error::{InputError, Result};
 use crate::geodesic::NodeId;
-use crate::mesh::{FaceId, Mesh, VertexId};
+use crate::mesh::{Mesh, VertexId};
 use crate::progress::Progress;
 
 /// Nodes that a path through cut `keep` of the pair (i, j) may not use.
@@ -44,11 +44,8 @@ fn blocked_for_cut(t: &Tracer, cl: &Clusters, keep: usize) -> Vec<NodeId> {
     }
     // Point contacts: vertices where the clusters touch without sharing an edge of this cut.
     let in_keep = |v: VertexId| c.vertices.binary_search(&v).is_ok();
-    for f in 0..mesh.n_faces() {
-        if cl.label[f] != i {
-            continue;
-        }
-        for v in mesh.face(FaceId::from_idx(f)) {
+    for &f in &cl.faces[i as usize] {
+        for v in mesh.face(f) {
             if !in_keep(v) && mesh.vertex_faces(v).any(|g2| cl.label[g2.idx()] == j) {
                 out.push(g.vertex_node(v));
             }
@@ -195,9 +192,9 @@ pub fn target_layout(
     let mut queue: Vec<usize> = (0..np).collect();
     let rank = |s: usize| priority.iter().position(|&p| p == s).unwrap_or(usize::MAX);
     queue.sort_by(|&x, &y| {
-        (rank(x), group(x), src.paths()[x].length)
-            .partial_cmp(&(rank(y), group(y), src.paths()[y].length))
-            .unwrap_or(std::cmp::Ordering::Equal)
+        // Within a group, the source's own order: on similar shapes the target then meets the
+        // same obstacles in the same sequence.
+        (rank(x), group(x), x).cmp(&(rank(y), group(y), y))
     });
     let mut tid: Vec<Option<u32>> = vec![None; np];
     let mut sid: Vec<u32> = Vec::with_capacity(np);
@@ -212,7 +209,7 @@ pub fn target_layout(
         for &s in &queue {
             let p = &src.paths()[s];
             let (ha, hb) = (2 * s as Half, 2 * s as Half + 1);
-            if group(s) == 2 && !force {
+            if group(s) == 2 && !force && rank(s) == usize::MAX {
                 // Postpone while another absent linkage of the pair shares this sector.
                 let ia = present_interval(src, &tid, p.a, ha);
                 let ambiguous = queue.iter().any(|&o| {

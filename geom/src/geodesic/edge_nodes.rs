@@ -79,6 +79,12 @@ struct Scratch {
 impl<'m> EdgeNodeGraph<'m> {
     /// Places the adaptive edge nodes.
     pub fn new(mesh: &'m Mesh, opts: &EdgeNodeOptions) -> Self {
+        Self::with_minimum(mesh, opts, &|_| 0)
+    }
+
+    /// Places the adaptive edge nodes, with at least `min_count(e)` on edge `e` (used to give
+    /// the rings of anchors room for many paths).
+    pub fn with_minimum(mesh: &'m Mesh, opts: &EdgeNodeOptions, min_count: &dyn Fn(EdgeId) -> u32) -> Self {
         let nv = mesh.n_vertices();
         let ne = mesh.n_edges();
         let len: Vec<f64> = (0..ne).map(|e| mesh.edge_length(EdgeId::from_idx(e))).collect();
@@ -99,7 +105,7 @@ impl<'m> EdgeNodeGraph<'m> {
             let n = (vcnt[a.idx()] + vcnt[c.idx()] - 1).max(1);
             let lbar = (vsum[a.idx()] + vsum[c.idx()] - l) / f64::from(n);
             let adaptive = if lbar > 0.0 { (f64::from(b) * l / lbar).ceil() } else { f64::from(b) };
-            let k = (adaptive as u32).clamp(b, opts.max_nodes.max(b));
+            let k = (adaptive as u32).clamp(b, opts.max_nodes.max(b)).max(min_count(EdgeId::from_idx(e)));
             count.push(k);
             first.push(next);
             next += k;

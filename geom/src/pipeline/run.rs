@@ -107,8 +107,11 @@ pub fn run_map(
         }
     };
     clock.lap("layout");
+    let (mut st, mut tt, mut stats) = (st, tt, stats);
+    stats.straightened = crate::domain::straighten::straighten(&mut st, o.layout.straighten_rounds, progress)?
+        + crate::domain::straighten::straighten(&mut tt, o.layout.straighten_rounds, progress)?;
+    clock.lap("straighten");
     let patches = patches_of(&st);
-    let mut stats = stats;
     stats.patches = patches.len();
     progress.check()?;
     let rs = refine(&st, &patches)?;

@@ -151,7 +151,7 @@ pub fn smooth(
             })
             .count()
     };
-    for _ in 0..opts.iterations {
+    for _ in 0..4 * opts.iterations.max(1) {
         let mut changed = false;
         for vi in 0..n {
             if is_fixed[vi] {
@@ -168,19 +168,28 @@ pub fn smooth(
                 k += 1.0;
             }
             let goal = P3::from(c / k.max(1.0));
-            let mut step = 1.0;
-            for _ in 0..4 {
-                let pr = loc.project(&P3::from(pos[vi].coords + (goal - pos[vi]) * step));
-                if flipped_at(v, &pos, &img_face, pr.point, pr.face) < cur {
-                    pos[vi] = pr.point;
-                    img_face[vi] = pr.face;
-                    map.face[vi] = pr.face;
-                    map.bary[vi] = pr.bary;
-                    rep.untangled += 1;
-                    changed = true;
-                    break;
+            // Candidates: towards the neighbours' mean, then half-way towards each neighbour.
+            let mut cands: Vec<P3> =
+                [1.0, 0.5, 0.25, 0.125].iter().map(|&t| P3::from(pos[vi].coords + (goal - pos[vi]) * t)).collect();
+            cands.extend(source.vertex_neighbors(v).map(|w| P3::from((pos[vi].coords + pos[w.idx()].coords) * 0.5)));
+            let mut best: Option<(usize, crate::topology::Projection)> = None;
+            for c in cands {
+                let pr = loc.project(&c);
+                let fl = flipped_at(v, &pos, &img_face, pr.point, pr.face);
+                if fl < cur && best.as_ref().is_none_or(|b| fl < b.0) {
+                    best = Some((fl, pr));
+                    if fl == 0 {
+                        break;
+                    }
                 }
-                step *= 0.5;
+            }
+            if let Some((_, pr)) = best {
+                pos[vi] = pr.point;
+                img_face[vi] = pr.face;
+                map.face[vi] = pr.face;
+                map.bary[vi] = pr.bary;
+                rep.untangled += 1;
+                changed = true;
             }
         }
         if !changed {

@@ -346,3 +346,59 @@ pub fn target_layout_with_restarts<'m>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::refine::refine;
+    use crate::domain::walks::is_complete;
+    use crate::domain::{patches_of, straighten::straighten};
+    use crate::mesh::{P3, shapes};
+    use crate::progress::NoProgress;
+
+    /// The six vertices of an icosphere nearest to the octahedron's corners.
+    fn octahedron_anchors(m: &Mesh) -> Vec<VertexId> {
+        let dirs =
+            [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+        dirs.iter()
+            .map(|d| {
+                let best = (0..m.n_vertices())
+                    .max_by(|&a, &b| {
+                        let p = |v: usize| m.position(VertexId::from_idx(v));
+                        let dot = |v: usize| p(v).x * d[0] + p(v).y * d[1] + p(v).z * d[2];
+                        dot(a).total_cmp(&dot(b))
+                    })
+                    .unwrap();
+                VertexId::from_idx(best)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn octahedral_layout_on_a_sphere_is_consistent_on_a_copy() {
+        let m = shapes::icosphere(3);
+        let a = octahedron_anchors(&m);
+        let mut s = Tracer::new(&m, &a, &Default::default()).unwrap();
+        let (cl, stats) = source_layout(&mut s, 2, &LayoutOptions::default(), &mut NoProgress).unwrap();
+        assert_eq!(cl.cuts.len(), 12, "the Voronoi cells of an octahedron meet along 12 cuts");
+        assert_eq!(stats.paths, 12);
+        assert!(is_complete(&s, 2));
+        let patches = patches_of(&s);
+        assert_eq!(patches.len(), 8);
+        // The same layout on a scaled copy, traced by Procedure 1: identical walks.
+        let scaled = m.with_positions(m.positions().iter().map(|p| P3::from(p.coords * 2.0)).collect()).unwrap();
+        let mut t = Tracer::new(&scaled, &a, &Default::default()).unwrap();
+        target_layout_with_restarts(&s, &mut t, &LayoutOptions::default(), 4, &mut NoProgress).unwrap();
+        assert_eq!(walks(&s), walks(&t));
+        // Straightening keeps every walk; refinement labels every face with a patch.
+        straighten(&mut t, 2, &mut NoProgress).unwrap();
+        assert_eq!(walks(&s), walks(&t));
+        let r = refine(&t, &patches).unwrap();
+        let mut seen = vec![false; patches.len()];
+        for &p in &r.patch {
+            seen[p as usize] = true;
+        }
+        assert!(seen.iter().all(|&x| x));
+        assert_eq!(crate::topology::euler_characteristic(&r.mesh), 2);
+    }
+}

@@ -8,6 +8,7 @@ pub mod compose;
 pub mod locate2d;
 pub mod patch_param;
 pub mod smooth;
+pub mod visible;
 
 pub use compose::compose;
 pub use patch_param::{PatchParam, PatchParamOptions, parameterize_patches};

@@ -33,6 +33,8 @@ impl Default for SmoothOptions {
 /// What smoothing did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct SmoothReport {
+    /// Points moved inside their face so that the evaluator's nearest-face rule finds it.
+    pub made_visible: usize,
     pub untangled: usize,
     pub moves: usize,
     pub rejected: usize,
@@ -43,6 +45,7 @@ pub struct SmoothReport {
 impl SmoothReport {
     pub fn merge(self, o: SmoothReport) -> SmoothReport {
         SmoothReport {
+            made_visible: self.made_visible + o.made_visible,
             untangled: self.untangled + o.untangled,
             moves: self.moves + o.moves,
             rejected: self.rejected + o.rejected,

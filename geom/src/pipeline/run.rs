@@ -133,7 +133,10 @@ pub fn run_map(
         (a, h.join().map_err(|_| Error::Internal("smoothing thread panicked".into())))
     });
     let (s2t, r1) = a?;
-    let (t2s, r2) = b??;
+    let (mut t2s, r2) = b??;
+    let mut s2t = s2t;
+    let visible = crate::crossparam::visible::make_visible(source, target, &mut s2t, &sa)?
+        + crate::crossparam::visible::make_visible(target, source, &mut t2s, &ta)?;
     clock.lap("smooth");
     let result = MapResult { source_to_target: s2t, target_to_source: t2s };
     let on_target = result.source_to_target.embed(source, target)?;
@@ -157,7 +160,7 @@ pub fn run_map(
         source_to_target: m1,
         target_to_source: m2,
         timings_ms: Vec::new(),
-        smoothing: r1.merge(r2),
+        smoothing: smooth::SmoothReport { made_visible: visible, ..r1.merge(r2) },
     };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, &result, &on_target, &on_source)?;
     clock.lap("artifacts");

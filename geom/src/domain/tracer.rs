@@ -149,8 +149,8 @@ impl<'m> Tracer<'m> {
             anchor_of[a.idx()] = i as u32;
         }
         // An anchor's ring must hold a free node between any two of its paths, and anchors can
-        // carry a dozen paths: the edges of anchor stars (and their opposite edges) get three
-        // times the minimal node count.
+        // carry a dozen paths: the edges of anchor stars (and their opposite edges) get
+        // `ring_factor` times the minimal node count.
         let mut boost = vec![false; mesh.n_edges()];
         for a in anchors {
             for h in mesh.outgoing(*a) {
@@ -158,7 +158,7 @@ impl<'m> Tracer<'m> {
                 boost[mesh.edge(h.next()).idx()] = true;
             }
         }
-        let ring_min = 3 * opts.min_nodes.max(1);
+        let ring_min = opts.ring_factor.max(1) * opts.min_nodes.max(1);
         let graph = EdgeNodeGraph::with_minimum(mesh, opts, &|e| if boost[e.idx()] { ring_min } else { 0 });
         let nn = graph.n_nodes();
         let mut ring_owner = vec![u32::MAX; nn];

@@ -192,9 +192,10 @@ pub fn target_layout(
     let mut queue: Vec<usize> = (0..np).collect();
     let rank = |s: usize| priority.iter().position(|&p| p == s).unwrap_or(usize::MAX);
     queue.sort_by(|&x, &y| {
-        // Within a group, the source's own order: on similar shapes the target then meets the
-        // same obstacles in the same sequence.
-        (rank(x), group(x), x).cmp(&(rank(y), group(y), y))
+        // Within a group, shortest source paths first.
+        (rank(x), group(x), src.paths()[x].length)
+            .partial_cmp(&(rank(y), group(y), src.paths()[y].length))
+            .unwrap_or(std::cmp::Ordering::Equal)
     });
     let mut tid: Vec<Option<u32>> = vec![None; np];
     let mut sid: Vec<u32> = Vec::with_capacity(np);

@@ -24,11 +24,13 @@ pub struct EdgeNodeOptions {
     pub min_nodes: u32,
     /// Upper bound per edge, against pathological slivers.
     pub max_nodes: u32,
+    /// Edges around anchors carry `ring_factor * min_nodes` nodes (1: no extra nodes).
+    pub ring_factor: u32,
 }
 
 impl Default for EdgeNodeOptions {
     fn default() -> Self {
-        Self { min_nodes: 3, max_nodes: 64 }
+        Self { min_nodes: 3, max_nodes: 64, ring_factor: 3 }
     }
 }
 

@@ -99,9 +99,16 @@ pub fn run_map(
                 if std::env::var_os("SURFMAP_DEBUG").is_some() {
                     eprintln!("rebuild after: {m}");
                 }
+                // Rebuild schedule: without the denser anchor rings, then with them again and
+                // twice (minus one) the nodes per edge, then without, and so on.
+                if edge_nodes.ring_factor > 1 {
+                    edge_nodes.ring_factor = 1;
+                } else {
+                    edge_nodes.ring_factor = o.layout.edge_nodes.ring_factor;
+                    edge_nodes.min_nodes = edge_nodes.min_nodes * 2 - 1;
+                    edge_nodes.max_nodes = edge_nodes.max_nodes.max(edge_nodes.min_nodes);
+                }
                 attempt += 1;
-                edge_nodes.min_nodes = edge_nodes.min_nodes * 2 - 1;
-                edge_nodes.max_nodes = edge_nodes.max_nodes.max(edge_nodes.min_nodes);
             }
             Err(e) => return Err(e),
         }

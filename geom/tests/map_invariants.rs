@@ -160,3 +160,13 @@ fn torus_twisted_genus_one() {
     let id: Vec<u32> = (0..s.n_vertices() as u32).collect();
     check(Method::Voronoi, &s, &t, &id, 24);
 }
+
+#[test]
+fn kitten_twisted_genus_one() {
+    // Needs a rip-up of a region on the source and restarts on the target.
+    let s = load("kitten.nf20k.off");
+    let t = twisted(&s);
+    let id: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let v = check(Method::Voronoi, &s, &t, &id, 24);
+    assert!(v.gt_mean <= 0.02, "gt {}", v.gt_mean);
+}

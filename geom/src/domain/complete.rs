@@ -14,6 +14,8 @@ use crate::progress::Progress;
 #[derive(Debug, Default, Clone, Copy)]
 pub struct CompleteStats {
     pub diagonals: usize,
+    /// Paths removed to merge a region that could not be split.
+    pub ripped: usize,
     pub attempts: usize,
 }
 
@@ -76,6 +78,7 @@ pub fn complete(
     progress: &mut dyn Progress,
 ) -> Result<CompleteStats> {
     let mut stats = CompleteStats::default();
+    let mut ripped: Vec<(u32, u32)> = Vec::new();
     'outer: loop {
         progress.check()?;
         if stats.attempts > max_attempts {
@@ -124,6 +127,28 @@ pub fn complete(
                 if try_link(ts, [(wi, i), (wi, j)], &mut stats)? {
                     continue 'outer;
                 }
+            }
+            // Rip up: drop the longest side of this region whose anchor pair was never dropped
+            // before, merging the region with its neighbour, and try again.
+            let t0: &Tracer = ts[0];
+            let mut sides: Vec<u32> = w.halves.iter().map(|&h| h / 2).collect();
+            sides.sort_unstable();
+            sides.dedup();
+            let pair = |p: u32| {
+                let q = &t0.paths()[p as usize];
+                (q.a.min(q.b), q.a.max(q.b))
+            };
+            let victim = sides
+                .into_iter()
+                .filter(|&p| !ripped.contains(&pair(p)))
+                .max_by(|&x, &y| t0.paths()[x as usize].length.total_cmp(&t0.paths()[y as usize].length));
+            if let Some(p) = victim {
+                ripped.push(pair(p));
+                stats.ripped += 1;
+                for t in ts.iter_mut() {
+                    t.remove(p);
+                }
+                continue 'outer;
             }
             return Err(InputError::LayoutConflict(format!(
                 "region with corners {c:?} cannot be split into triangles by non-crossing paths"

@@ -101,10 +101,12 @@ pub struct LayoutStats {
     pub straightened: usize,
 }
 
-/// Patches from the walks of a complete layout.
+/// Patches from the walks of a layout: its triangular walks (all of them once the layout is
+/// complete).
 pub fn patches_of(t: &tracer::Tracer) -> Vec<Patch> {
     walks::walks(t)
         .into_iter()
+        .filter(|w| w.halves.len() == 3)
         .map(|w| {
             let c = w.corners(t);
             Patch { corners: [c[0], c[1], c[2]], sides: [w.halves[0], w.halves[1], w.halves[2]] }

@@ -64,6 +64,7 @@ struct Filter<'a, 't> {
 /// an anchor): paths keep a free node between them where they can, so that no region between
 /// two paths is left without nodes to pass through, yet may touch where they must.
 const CLEARANCE_PENALTY: f64 = 4.0;
+const RING_PENALTY: f64 = 1000.0;
 
 impl Filter<'_, '_> {
     fn next_to_used(&self, n: NodeId) -> bool {
@@ -106,7 +107,11 @@ impl SearchFilter for Filter<'_, '_> {
         if owner < u32::MAX - 1 && owner != self.ends[0] && owner != self.ends[1] {
             // Passing right next to another anchor crowds its sectors.
             CLEARANCE_PENALTY
-        } else if self.t.near[n.0 as usize] || self.next_to_used(n) {
+        } else if self.t.near[n.0 as usize] {
+            // Leaving an anchor right beside one of its paths would leave a sector without a
+            // free ring node: only as a last resort.
+            RING_PENALTY
+        } else if self.next_to_used(n) {
             CLEARANCE_PENALTY
         } else {
             1.0
@@ -371,6 +376,22 @@ impl<'m> Tracer<'m> {
         let pos = r.partition_point(|&(k2, _)| k2 < key);
         let n = r.len();
         Some(Sector { from: r[(pos + n - 1) % n].0, to: r[pos % n].0 })
+    }
+
+    /// Deletes path `id`; the last path takes its index.
+    pub fn remove(&mut self, id: u32) {
+        let _ = self.lift(id);
+        let last = self.paths.len() as u32 - 1;
+        if id != last {
+            for r in &mut self.rot {
+                for (_, h) in r.iter_mut() {
+                    if *h / 2 == last {
+                        *h = 2 * id + *h % 2;
+                    }
+                }
+            }
+        }
+        self.paths.swap_remove(id as usize);
     }
 
     /// Re-traces path `id` as the shortest path in the same sectors at both ends (so within the

@@ -289,15 +289,6 @@ pub fn target_layout(
                             eprintln!("  open walk {:?} halves {:?}", w.corners(tgt), w.halves);
                         }
                     }
-                    let r = super::refine::refine(tgt, &super::patches_of(tgt));
-                    eprintln!("  refine: {:?}", r.as_ref().err());
-                    if let Ok(r) = r {
-                        let mut cnt = std::collections::HashMap::new();
-                        for &p in &r.patch {
-                            *cnt.entry(p).or_insert(0) += 1;
-                        }
-                        eprintln!("  labelled regions {} of {} walks", cnt.len(), walks(tgt).len());
-                    }
                 }
             }
             return Ok(Err(s));

@@ -26,7 +26,7 @@ pub struct SmoothOptions {
 
 impl Default for SmoothOptions {
     fn default() -> Self {
-        Self { iterations: 5, step: 1.0 }
+        Self { iterations: 3, step: 1.0 }
     }
 }
 

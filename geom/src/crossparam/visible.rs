@@ -2,8 +2,8 @@
 //! distance of a point to the surface over the 24 faces whose centroids are nearest to it; a
 //! point that lies exactly on a large face bordered by many small ones (hole fills, slivers) can
 //! be judged off the surface although it is on it. Such points are moved inside their own face
-//! towards its centroid, by the smallest of a few steps that makes the face visible, unless that
-//! turns an incident face against the target. Anchors never move.
+//! towards its centroid (or, failing that, onto a corner), by the smallest step that makes it
+//! visible, unless more incident faces then face against the target at all their corners. Anchors never move.
 
 use crate::map::SurfaceMap;
 use crate::mesh::{FaceId, Mesh, P3, VertexId};
@@ -30,16 +30,36 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
         let f = map.face[vi];
         let b = map.bary[vi];
         let v = VertexId::from_idx(vi);
-        let ok_faces = |p: P3, pos: &[P3]| {
-            source.outgoing(v).all(|h| {
-                let tri = source.face(h.face());
-                let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
-                let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
-                nm.dot(&target.face_normal_raw(f)) > 0.0
-            })
+        // Incident faces that face against the target at all their corners (the evaluator's
+        // flip rule, with the faces the corners lie on).
+        let faces = &map.face;
+        let against = |p: P3, pos: &[P3]| {
+            source
+                .outgoing(v)
+                .filter(|h| {
+                    let tri = source.face(h.face());
+                    let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
+                    let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+                    tri.iter().all(|&w| {
+                        let g = if w == v { f } else { faces[w.idx()] };
+                        nm.dot(&target.face_normal_raw(g)) < 0.0
+                    })
+                })
+                .count()
         };
-        for t in [0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0] {
-            let nb = b.map(|x| x * (1.0 - t) + t / 3.0);
+        let before = against(pos[vi], &pos);
+        let ok_faces = |p: P3, pos: &[P3]| against(p, pos) <= before;
+        // Towards the centroid first, then onto the face's corners (nearest first).
+        let mut cands: Vec<[f64; 3]> =
+            [0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0].iter().map(|&t| b.map(|x| x * (1.0 - t) + t / 3.0)).collect();
+        let mut corners = [0usize, 1, 2];
+        corners.sort_by(|&x, &y| b[y].total_cmp(&b[x]));
+        for k in corners {
+            let mut e = [0.0; 3];
+            e[k] = 1.0;
+            cands.push(e);
+        }
+        for nb in cands {
             let [p0, p1, p2] = target.face_points(f);
             let p = P3::from(p0.coords * nb[0] + p1.coords * nb[1] + p2.coords * nb[2]);
             if index.query(&p).distance <= tol && ok_faces(p, &pos) {

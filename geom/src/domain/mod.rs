@@ -71,7 +71,7 @@ pub struct LayoutOptions {
 
 impl Default for LayoutOptions {
     fn default() -> Self {
-        Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 3, straighten_rounds: 2 }
+        Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 3, straighten_rounds: 1 }
     }
 }
 

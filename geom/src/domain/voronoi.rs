@@ -147,6 +147,30 @@ fn target_sector(src: &Tracer, tgt: &Tracer, tid: &[Option<u32>], x: u32, hs: Ha
     None
 }
 
+/// Sorted cluster labels (anchor indices) of the source faces that source path `s` touches.
+fn corridor_of(src: &Tracer, cl: &Clusters, s: usize) -> Vec<u32> {
+    let m = src.mesh();
+    let g = src.graph();
+    let p = &src.paths()[s];
+    let mut out = vec![p.a, p.b];
+    for &n in &p.nodes {
+        match g.as_edge_node(n) {
+            Some((e, _)) => {
+                let (f, h) = m.edge_faces(e);
+                out.push(cl.label[f.idx()]);
+                if let Some(h) = h {
+                    out.push(cl.label[h.idx()]);
+                }
+            }
+            None => out.extend(m.vertex_faces(VertexId(n.0)).map(|f| cl.label[f.idx()])),
+        }
+    }
+    out.retain(|&l| l != u32::MAX);
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
 /// The present-path interval (predecessor, successor) around `hs` in the source rotation.
 fn present_interval(src: &Tracer, tid: &[Option<u32>], x: u32, hs: Half) -> (Option<Half>, Option<Half>) {
     let r = src.rotation(x);
@@ -165,6 +189,7 @@ fn present_interval(src: &Tracer, tid: &[Option<u32>], x: u32, hs: Half) -> (Opt
 /// `InputError::LayoutConflict` naming the first path that cannot be traced consistently.
 pub fn target_layout(
     src: &Tracer,
+    src_clusters: &Clusters,
     tgt: &mut Tracer,
     opts: &LayoutOptions,
     priority: &[usize],
@@ -235,7 +260,12 @@ pub fn target_layout(
             }
             let sector_a = target_sector(src, tgt, &tid, p.a, ha);
             let sector_b = target_sector(src, tgt, &tid, p.b, hb);
-            let mask = (group(s) != 1).then(|| cl.mask(p.a, p.b));
+            // The corridor: target faces in the clusters of the anchors whose source clusters the
+            // source path crosses (its two ends' included). The Voronoi cells guide the path
+            // around the same side of every handle and limb as on the source.
+            let corridor = corridor_of(src, src_clusters, s);
+            let mask: Option<Vec<bool>> =
+                Some(cl.label.iter().map(|&l| l != u32::MAX && corridor.binary_search(&l).is_ok()).collect());
             let mut req = TraceRequest { a: p.a, b: p.b, faces: mask.as_deref(), sector_a, sector_b, blocked: &[] };
             let mut got = tgt.trace(&req)?;
             if got.is_none() && req.faces.is_some() {
@@ -312,6 +342,7 @@ pub fn target_layout(
 /// `InputError::LayoutConflict` naming the path that still cannot be traced.
 pub fn target_layout_with_restarts<'m>(
     src: &Tracer,
+    src_clusters: &Clusters,
     tgt: &mut Tracer<'m>,
     opts: &LayoutOptions,
     restarts: usize,
@@ -320,7 +351,7 @@ pub fn target_layout_with_restarts<'m>(
     let mut priority: Vec<usize> = Vec::new();
     loop {
         let mut fresh = Tracer::new(tgt.mesh(), tgt.anchors(), &tgt.edge_node_options())?;
-        match target_layout(src, &mut fresh, opts, &priority, progress)? {
+        match target_layout(src, src_clusters, &mut fresh, opts, &priority, progress)? {
             Ok(mut s) => {
                 s.postponed += priority.len();
                 *tgt = fresh;
@@ -380,7 +411,7 @@ mod tests {
         // The same layout on a scaled copy, traced by Procedure 1: identical walks.
         let scaled = m.with_positions(m.positions().iter().map(|p| P3::from(p.coords * 2.0)).collect()).unwrap();
         let mut t = Tracer::new(&scaled, &a, &Default::default()).unwrap();
-        target_layout_with_restarts(&s, &mut t, &LayoutOptions::default(), 4, &mut NoProgress).unwrap();
+        target_layout_with_restarts(&s, &cl, &mut t, &LayoutOptions::default(), 4, &mut NoProgress).unwrap();
         assert_eq!(walks(&s), walks(&t));
         // Straightening keeps every walk; refinement labels every face with a patch.
         straighten(&mut t, 2, &mut NoProgress).unwrap();

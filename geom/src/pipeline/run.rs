@@ -81,8 +81,8 @@ pub fn run_map(
         let mut st = Tracer::new(source, &sa, &edge_nodes)?;
         let mut tt = Tracer::new(target, &ta, &edge_nodes)?;
         let built = match spec.method {
-            Method::Voronoi => voronoi::source_layout(&mut st, chi, &o.layout, progress).and_then(|(_, mut s)| {
-                let t = voronoi::target_layout_with_restarts(&st, &mut tt, &o.layout, 8, progress)?;
+            Method::Voronoi => voronoi::source_layout(&mut st, chi, &o.layout, progress).and_then(|(cl, mut s)| {
+                let t = voronoi::target_layout_with_restarts(&st, &cl, &mut tt, &o.layout, 8, progress)?;
                 s.postponed = t.postponed;
                 s.failed_traces += t.failed_traces;
                 Ok(s)

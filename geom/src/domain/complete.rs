@@ -122,6 +122,27 @@ pub fn complete(
                     cand.push((dist(t0, c[i], c[j]), i, j));
                 }
             }
+            // Rank by the length of the path each diagonal would really take on the first mesh
+            // (the shortest admissible one wins, as in the shortest-first heuristic), falling
+            // back to the straight-line distance for diagonals that do not trace there.
+            if cand.len() > 1 {
+                let sec: Vec<_> = (0..n).map(|i| w.sector(t0, i)).collect();
+                let t0m: &mut Tracer = ts[0];
+                for x in cand.iter_mut() {
+                    stats.attempts += 1;
+                    let req = TraceRequest {
+                        a: c[x.1],
+                        b: c[x.2],
+                        sector_a: Some(sec[x.1]),
+                        sector_b: Some(sec[x.2]),
+                        ..Default::default()
+                    };
+                    x.0 = match t0m.trace(&req)? {
+                        Some(p) => p.length,
+                        None => f64::INFINITY,
+                    };
+                }
+            }
             cand.sort_by(|a, b| a.0.total_cmp(&b.0));
             for (_, i, j) in cand {
                 if try_link(ts, [(wi, i), (wi, j)], &mut stats)? {

@@ -170,3 +170,13 @@ fn kitten_twisted_genus_one() {
     let v = check(Method::Voronoi, &s, &t, &id, 24);
     assert!(v.gt_mean <= 0.02, "gt {}", v.gt_mean);
 }
+
+#[test]
+fn torus_six_anchors_as_in_the_papers_fig1() {
+    // Six anchors on a torus admit no simplicial triangulation: the layout needs multiple
+    // linkages or repeated pairs, which the Voronoi method supports.
+    let s = load("torus.obj");
+    let t = twisted(&s);
+    let id: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    check(Method::Voronoi, &s, &t, &id, 6);
+}

@@ -10,6 +10,9 @@ use super::walks::{Walk, graph_components, walks};
 use crate::error::{InputError, Result};
 use crate::progress::Progress;
 
+/// How often the paths between one anchor pair may be ripped up.
+const MAX_RIPS_PER_PAIR: usize = 3;
+
 /// Counts of what completion added.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct CompleteStats {
@@ -149,8 +152,8 @@ pub fn complete(
                     continue 'outer;
                 }
             }
-            // Rip up: drop the longest side of this region whose anchor pair was never dropped
-            // before, merging the region with its neighbour, and try again.
+            // Rip up: drop the longest side of this region whose anchor pair was not dropped
+            // too often already, merging the region with its neighbour, and try again.
             let t0: &Tracer = ts[0];
             let mut sides: Vec<u32> = w.halves.iter().map(|&h| h / 2).collect();
             sides.sort_unstable();
@@ -161,7 +164,7 @@ pub fn complete(
             };
             let victim = sides
                 .into_iter()
-                .filter(|&p| !ripped.contains(&pair(p)))
+                .filter(|&p| ripped.iter().filter(|&&q| q == pair(p)).count() < MAX_RIPS_PER_PAIR)
                 .max_by(|&x, &y| t0.paths()[x as usize].length.total_cmp(&t0.paths()[y as usize].length));
             if let Some(p) = victim {
                 ripped.push(pair(p));

@@ -152,7 +152,7 @@ pub fn complete(
                     continue 'outer;
                 }
             }
-            // Rip up: drop the longest side of this region whose anchor pair was not dropped
+            // Rip up: drop the shortest side of this region whose anchor pair was not dropped
             // too often already, merging the region with its neighbour, and try again.
             let t0: &Tracer = ts[0];
             let mut sides: Vec<u32> = w.halves.iter().map(|&h| h / 2).collect();
@@ -165,7 +165,7 @@ pub fn complete(
             let victim = sides
                 .into_iter()
                 .filter(|&p| ripped.iter().filter(|&&q| q == pair(p)).count() < MAX_RIPS_PER_PAIR)
-                .max_by(|&x, &y| t0.paths()[x as usize].length.total_cmp(&t0.paths()[y as usize].length));
+                .min_by(|&x, &y| t0.paths()[x as usize].length.total_cmp(&t0.paths()[y as usize].length));
             if let Some(p) = victim {
                 ripped.push(pair(p));
                 stats.ripped += 1;

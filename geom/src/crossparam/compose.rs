@@ -9,7 +9,7 @@ use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::param::Uv;
 
 /// Where each original vertex of mesh A sits in the patch parameterization: (patch, uv).
-pub fn vertex_uv(ra: &Refined, pa: &[PatchParam], n: usize) -> Vec<(u32, Uv)> {
+pub fn vertex_uv(pa: &[PatchParam], n: usize) -> Vec<(u32, Uv)> {
     let mut out = vec![(u32::MAX, [0.0; 2]); n];
     for (pi, p) in pa.iter().enumerate() {
         for (l, g) in p.global_v.iter().enumerate() {
@@ -18,7 +18,6 @@ pub fn vertex_uv(ra: &Refined, pa: &[PatchParam], n: usize) -> Vec<(u32, Uv)> {
             }
         }
     }
-    let _ = ra;
     out
 }
 
@@ -40,26 +39,16 @@ pub fn locate_in(rb: &Refined, b: &Mesh, pb: &[PatchParam], patch: u32, uv: Uv) 
 }
 
 /// The map from A's original vertices to B's surface. Anchors go exactly to their partners.
-#[allow(clippy::too_many_arguments)]
 pub fn compose(
-    ra: &Refined,
     pa: &[PatchParam],
     a: &Mesh,
     rb: &Refined,
     pb: &[PatchParam],
     b: &Mesh,
     anchors: &[(VertexId, VertexId)],
-    uv_override: Option<&[(u32, Uv)]>,
 ) -> SurfaceMap {
     let n = a.n_vertices();
-    let own;
-    let uv = match uv_override {
-        Some(u) => u,
-        None => {
-            own = vertex_uv(ra, pa, n);
-            &own
-        }
-    };
+    let uv = vertex_uv(pa, n);
     let mut face = Vec::with_capacity(n);
     let mut bary = Vec::with_capacity(n);
     for &(patch, p) in uv.iter().take(n) {

@@ -73,7 +73,7 @@ fn tri_energy(s: [P3; 3], m: [P3; 3], scale: f64) -> Option<f64> {
         Some(([l, e2.dot(&x)], [0.0, e2.dot(&y)], 0.5 * nn))
     };
     let (s0, s1, area_s) = frame(s)?;
-    let (m0, m1, area_m) = frame(m)?;
+    let (m0, m1, _) = frame(m)?;
     // J = M S^-1 with S = [[s0.0, s0.1],[s1.0, s1.1]] (upper triangular).
     let det_s = s0[0] * s1[1];
     let inv = [[1.0 / s0[0], -s0[1] / det_s], [0.0, 1.0 / s1[1]]];
@@ -83,8 +83,30 @@ fn tri_energy(s: [P3; 3], m: [P3; 3], scale: f64) -> Option<f64> {
     if det <= 0.0 {
         return None;
     }
-    let _ = area_m;
     Some(area_s * (fro + fro / (det * det)))
+}
+
+/// Faces of `v`'s star in `source` that face against `target` at all their corners (the
+/// evaluator's flip rule, with the target faces the corners lie on), were `v`'s image at `p`
+/// on face `f` and every other vertex `w` at `pos[w]` on face `faces[w]`.
+pub(crate) fn flipped_in_star(
+    source: &Mesh,
+    target: &Mesh,
+    v: VertexId,
+    p: P3,
+    f: FaceId,
+    pos: &[P3],
+    faces: &[FaceId],
+) -> usize {
+    source
+        .outgoing(v)
+        .filter(|h| {
+            let tri = source.face(h.face());
+            let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
+            let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+            tri.iter().all(|&w| nm.dot(&target.face_normal_raw(if w == v { f } else { faces[w.idx()] })) < 0.0)
+        })
+        .count()
 }
 
 /// Relaxes `map: source -> target`. `fixed` vertices (the anchors) never move.
@@ -132,27 +154,18 @@ pub fn smooth(
         }
         Some(e)
     };
-    let total = |pos: &[P3], img_face: &[FaceId]| -> f64 {
+    let total = |pos: &[P3]| -> f64 {
         (0..source.n_faces())
             .filter_map(|f| {
                 let tri = source.face(FaceId::from_idx(f));
                 tri_energy(source.face_points(FaceId::from_idx(f)), tri.map(|w| pos[w.idx()]), scale)
             })
             .sum::<f64>()
-            + 0.0 * img_face.len() as f64
     };
     // Untangle first: a vertex of a face that faces against the target at all its corners
     // moves towards its neighbours' images if that lowers the number of such faces.
     let flipped_at = |v: VertexId, pos: &[P3], img_face: &[FaceId], p: P3, f: FaceId| -> usize {
-        source
-            .outgoing(v)
-            .filter(|h| {
-                let tri = source.face(h.face());
-                let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
-                let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
-                tri.iter().all(|&w| nm.dot(&tnormal(if w == v { f } else { img_face[w.idx()] })) < 0.0)
-            })
-            .count()
+        flipped_in_star(source, target, v, p, f, pos, img_face)
     };
     for _ in 0..4 * opts.iterations.max(1) {
         let mut changed = false;
@@ -199,7 +212,7 @@ pub fn smooth(
             break;
         }
     }
-    rep.energy_before = total(&pos, &img_face);
+    rep.energy_before = total(&pos);
     for it in 0..opts.iterations {
         progress.check()?;
         progress.report("smooth", it as f64 / opts.iterations as f64);
@@ -243,6 +256,6 @@ pub fn smooth(
             }
         }
     }
-    rep.energy_after = total(&pos, &img_face);
+    rep.energy_after = total(&pos);
     Ok((map, rep))
 }

@@ -5,8 +5,9 @@
 //! towards its centroid (or, failing that, onto a corner), by the smallest step that makes it
 //! visible, unless more incident faces then face against the target at all their corners. Anchors never move.
 
+use super::smooth::flipped_in_star;
 use crate::map::SurfaceMap;
-use crate::mesh::{FaceId, Mesh, P3, VertexId};
+use crate::mesh::{Mesh, P3, VertexId};
 use crate::metrics::SurfaceIndex;
 
 /// Moves hidden points; returns how many moved.
@@ -33,20 +34,7 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
         // Incident faces that face against the target at all their corners (the evaluator's
         // flip rule, with the faces the corners lie on).
         let faces = &map.face;
-        let against = |p: P3, pos: &[P3]| {
-            source
-                .outgoing(v)
-                .filter(|h| {
-                    let tri = source.face(h.face());
-                    let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
-                    let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
-                    tri.iter().all(|&w| {
-                        let g = if w == v { f } else { faces[w.idx()] };
-                        nm.dot(&target.face_normal_raw(g)) < 0.0
-                    })
-                })
-                .count()
-        };
+        let against = |p: P3, pos: &[P3]| flipped_in_star(source, target, v, p, f, pos, faces);
         let before = against(pos[vi], &pos);
         let ok_faces = |p: P3, pos: &[P3]| against(p, pos) <= before;
         // Towards the centroid first, then onto the face's corners (nearest first).
@@ -70,6 +58,5 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
             }
         }
     }
-    let _: Option<FaceId> = None;
     Ok(moved)
 }

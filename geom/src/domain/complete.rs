@@ -6,7 +6,7 @@
 //! walks. Works on several meshes at once: a path is inserted only if it traces on all of them.
 
 use super::tracer::{TraceRequest, Tracer};
-use super::walks::{Walk, graph_components, walks};
+use super::walks::{graph_components, walks};
 use crate::error::{InputError, Result};
 use crate::progress::Progress;
 
@@ -212,9 +212,4 @@ pub fn complete(
         )
         .into());
     }
-}
-
-/// Walks that are not triangles, for reports.
-pub fn open_walks(t: &Tracer) -> Vec<Walk> {
-    walks(t).into_iter().filter(|w| !w.is_triangle(t)).collect()
 }

@@ -2,6 +2,7 @@
 //! A cut is a maximal run of edges, connected through shared vertices, along which the same
 //! two clusters touch; two clusters may share several cuts (Observation 2).
 
+use super::uf_find;
 use crate::error::Result;
 use crate::geodesic::{FaceVoronoiOptions, face_voronoi};
 use crate::mesh::{EdgeId, FaceId, Mesh, VertexId};
@@ -61,18 +62,11 @@ pub fn clusters(mesh: &Mesh, anchors: &[VertexId]) -> Result<Clusters> {
     for ((i, j), edges) in pairs {
         // Union-find over the pair's edges through shared vertices.
         let mut parent: Vec<usize> = (0..edges.len()).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
         let mut at_vertex: HashMap<VertexId, usize> = HashMap::new();
         for (k, &e) in edges.iter().enumerate() {
             for v in mesh.edge_vertices(e) {
                 if let Some(&o) = at_vertex.get(&v) {
-                    let (a, b) = (find(&mut parent, k), find(&mut parent, o));
+                    let (a, b) = (uf_find(&mut parent, k), uf_find(&mut parent, o));
                     parent[a] = b;
                 } else {
                     at_vertex.insert(v, k);
@@ -81,7 +75,7 @@ pub fn clusters(mesh: &Mesh, anchors: &[VertexId]) -> Result<Clusters> {
         }
         let mut groups: HashMap<usize, Vec<EdgeId>> = HashMap::new();
         for (k, &e) in edges.iter().enumerate() {
-            groups.entry(find(&mut parent, k)).or_default().push(e);
+            groups.entry(uf_find(&mut parent, k)).or_default().push(e);
         }
         let mut gs: Vec<Vec<EdgeId>> = groups.into_values().collect();
         gs.sort_unstable_by_key(|g| std::cmp::Reverse(g.len()));

@@ -28,6 +28,15 @@ pub struct LayoutPath {
     pub length: f64,
 }
 
+/// Root of `x` in a union-find forest (with path halving).
+pub(crate) fn uf_find(p: &mut [usize], mut x: usize) -> usize {
+    while p[x] != x {
+        p[x] = p[p[x]];
+        x = p[x];
+    }
+    x
+}
+
 /// A cyclic interval of ring keys around an anchor, both ends excluded; `from == to` means
 /// every key but that one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -73,15 +82,6 @@ impl Default for LayoutOptions {
     fn default() -> Self {
         Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 3, straighten_rounds: 1 }
     }
-}
-
-/// The common base domain: the same paths (by index) and patches on both meshes.
-pub struct LayoutPair<'s, 't> {
-    pub source: tracer::Tracer<'s>,
-    pub target: tracer::Tracer<'t>,
-    pub patches: Vec<Patch>,
-    /// Stage timings and counts, for reports.
-    pub stats: LayoutStats,
 }
 
 /// What a layout construction did.

@@ -6,8 +6,8 @@
 //! For a connected graph on a closed surface, `V - E + W = χ` holds exactly when every region
 //! is a disk bounded by one walk (each non-disk region adds at least one walk or a handle).
 
-use super::Sector;
 use super::tracer::{Half, Tracer};
+use super::{Sector, uf_find};
 
 /// One face walk: `halves[i]` arrives where `halves[i + 1]` leaves.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -67,18 +67,11 @@ impl Walk {
 pub fn graph_components(t: &Tracer) -> (usize, bool) {
     let na = t.anchors().len();
     let mut parent: Vec<usize> = (0..na).collect();
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
     for p in t.paths() {
-        let (a, b) = (find(&mut parent, p.a as usize), find(&mut parent, p.b as usize));
+        let (a, b) = (uf_find(&mut parent, p.a as usize), uf_find(&mut parent, p.b as usize));
         parent[a] = b;
     }
-    let comps = (0..na).filter(|&i| find(&mut parent, i) == i).count();
+    let comps = (0..na).filter(|&i| uf_find(&mut parent, i) == i).count();
     let all = (0..na as u32).all(|a| !t.rotation(a).is_empty());
     (comps, all)
 }

@@ -129,8 +129,8 @@ pub fn run_map(
     clock.lap("parameterize");
     progress.report("compose", 0.0);
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
-    let s2t = compose(&rs, &ps, source, &rt, &pt, target, &pairs, None);
-    let t2s = compose(&rt, &pt, target, &rs, &ps, source, &rev, None);
+    let s2t = compose(&ps, source, &rt, &pt, target, &pairs);
+    let t2s = compose(&pt, target, &rs, &ps, source, &rev);
     clock.lap("compose");
     progress.check()?;
     // The two directions are independent: smooth them on two threads.

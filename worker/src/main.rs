@@ -1,0 +1,94 @@
+//! `surfmap-worker`: a separate process that claims and runs jobs from the store. Run any
+//! number of them, on any machine that reaches the database and the data directory.
+
+use clap::Parser;
+use std::path::PathBuf;
+use std::time::Duration;
+use surfmap_worker::{Worker, WorkerConfig};
+
+#[derive(Debug, Parser)]
+#[command(name = "surfmap-worker", version, about = "Claims surfmap jobs from the store and runs them")]
+struct Args {
+    /// sqlite://PATH or postgres://…
+    #[arg(long, env = "SURFMAP_DATABASE_URL", default_value = "sqlite://surfmap.db")]
+    database_url: String,
+    /// Directory of the content-addressed blobs (shared with the server).
+    #[arg(long, env = "SURFMAP_DATA_DIR", default_value = "./surfmap-data")]
+    data_dir: PathBuf,
+    /// Lease owner name [default: host-pid-random].
+    #[arg(long, env = "SURFMAP_WORKER_ID")]
+    worker_id: Option<String>,
+    /// Lease length in seconds; heartbeats extend it.
+    #[arg(long, env = "SURFMAP_LEASE_SECS", default_value_t = 30.0)]
+    lease_secs: f64,
+    /// Idle wait between claims, in milliseconds.
+    #[arg(long, env = "SURFMAP_POLL_MS", default_value_t = 500)]
+    poll_ms: u64,
+    /// Wall-clock limit per job, in seconds.
+    #[arg(long, env = "SURFMAP_TIME_LIMIT_SECS", default_value_t = 1800)]
+    time_limit_secs: u64,
+    /// Largest mesh, in vertices.
+    #[arg(long, env = "SURFMAP_MAX_VERTICES", default_value_t = 2_000_000)]
+    max_vertices: u64,
+    /// On SIGTERM, how long the current job may finish before its lease is released.
+    #[arg(long, env = "SURFMAP_SHUTDOWN_GRACE_SECS", default_value_t = 60)]
+    shutdown_grace_secs: u64,
+}
+
+#[tokio::main]
+async fn main() -> std::process::ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info,sqlx=warn".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let a = Args::parse();
+    match run(a).await {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("surfmap-worker: {e:#}");
+            std::process::ExitCode::from(1)
+        }
+    }
+}
+
+async fn run(a: Args) -> anyhow::Result<()> {
+    if !(a.lease_secs.is_finite() && a.lease_secs > 0.0) {
+        anyhow::bail!("--lease-secs must be positive");
+    }
+    let store = surfmap_store::Store::connect(&a.database_url).await?;
+    let blobs = surfmap_store::BlobStore::open(&a.data_dir)?;
+    let config = WorkerConfig {
+        id: a.worker_id.unwrap_or_else(WorkerConfig::default_id),
+        lease: Duration::from_secs_f64(a.lease_secs),
+        poll: Duration::from_millis(a.poll_ms),
+        time_limit: Duration::from_secs(a.time_limit_secs),
+        max_vertices: a.max_vertices,
+        shutdown_grace: Duration::from_secs(a.shutdown_grace_secs),
+    };
+    println!("worker {} ready", config.id);
+    let (tx, rx) = tokio::sync::watch::channel(false);
+    tokio::spawn(async move {
+        shutdown_signal().await;
+        let _ = tx.send(true);
+    });
+    Worker { store, blobs, config }.run(rx).await;
+    Ok(())
+}
+
+/// SIGTERM or Ctrl-C.
+pub async fn shutdown_signal() {
+    let ctrl_c = tokio::signal::ctrl_c();
+    let mut term = match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
+        Ok(s) => s,
+        Err(_) => {
+            let _ = ctrl_c.await;
+            return;
+        }
+    };
+    tokio::select! {
+        _ = ctrl_c => {}
+        _ = term.recv() => {}
+    }
+}

@@ -1,0 +1,68 @@
+//! The bridge between the pipeline's `Progress` calls (on the blocking thread) and the
+//! heartbeat (on the runtime): stage names map onto one monotone job fraction.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// Where each pipeline stage starts and how much of the job it spans.
+const STAGES: &[(&str, f64, f64)] = &[
+    ("layout", 0.0, 0.02),
+    ("layout_source", 0.02, 0.13),
+    ("layout_target", 0.15, 0.2),
+    ("layout_greedy", 0.02, 0.33),
+    ("straighten", 0.35, 0.05),
+    ("parameterize", 0.40, 0.15),
+    ("compose", 0.55, 0.05),
+    ("smooth", 0.60, 0.20),
+    ("metrics", 0.80, 0.18),
+    ("done", 1.0, 0.0),
+];
+
+/// Shared between the pipeline thread and the heartbeat task.
+#[derive(Debug, Clone, Default)]
+pub struct Shared {
+    state: Arc<Mutex<(String, f64)>>,
+    cancel: Arc<AtomicBool>,
+}
+
+impl Shared {
+    pub fn snapshot(&self) -> (String, f64) {
+        self.state.lock().map(|s| s.clone()).unwrap_or_else(|p| p.into_inner().clone())
+    }
+    pub fn cancel(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+}
+
+impl geom::progress::Progress for Shared {
+    fn report(&mut self, stage: &str, fraction: f64) {
+        let overall = STAGES.iter().find(|s| s.0 == stage).map(|&(_, base, span)| base + span * fraction.clamp(0.0, 1.0));
+        if let Ok(mut s) = self.state.lock() {
+            s.0 = stage.to_string();
+            if let Some(o) = overall {
+                s.1 = s.1.max(o);
+            }
+        }
+    }
+    fn cancelled(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geom::progress::Progress;
+
+    #[test]
+    fn fraction_is_monotone_and_cancel_is_seen() {
+        let mut s = Shared::default();
+        s.report("smooth", 0.5);
+        assert_eq!(s.snapshot(), ("smooth".to_string(), 0.7));
+        s.report("layout", 1.0);
+        assert_eq!(s.snapshot().1, 0.7);
+        assert!(s.check().is_ok());
+        s.clone().cancel();
+        assert!(s.check().is_err());
+    }
+}

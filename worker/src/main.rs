@@ -70,25 +70,9 @@ async fn run(a: Args) -> anyhow::Result<()> {
     println!("worker {} ready", config.id);
     let (tx, rx) = tokio::sync::watch::channel(false);
     tokio::spawn(async move {
-        shutdown_signal().await;
+        surfmap_worker::shutdown_signal().await;
         let _ = tx.send(true);
     });
     Worker { store, blobs, config }.run(rx).await;
     Ok(())
-}
-
-/// SIGTERM or Ctrl-C.
-pub async fn shutdown_signal() {
-    let ctrl_c = tokio::signal::ctrl_c();
-    let mut term = match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
-        Ok(s) => s,
-        Err(_) => {
-            let _ = ctrl_c.await;
-            return;
-        }
-    };
-    tokio::select! {
-        _ = ctrl_c => {}
-        _ = term.recv() => {}
-    }
 }

@@ -99,7 +99,15 @@ impl JobSpec {
     /// # Errors
     /// `InputError::TopologyMismatch`, `InputError::Anchors`.
     pub fn validate(&self, source: &Mesh, target: &Mesh) -> Result<Vec<(VertexId, VertexId)>> {
-        let (ss, ts) = (topology::summary(source), topology::summary(target));
+        self.check(&topology::summary(source), &topology::summary(target))
+    }
+
+    /// [`JobSpec::validate`] from the meshes' summaries alone, so a server can answer before
+    /// it queues a job without rebuilding the meshes.
+    ///
+    /// # Errors
+    /// `InputError::TopologyMismatch`, `InputError::Anchors`.
+    pub fn check(&self, ss: &topology::Summary, ts: &topology::Summary) -> Result<Vec<(VertexId, VertexId)>> {
         if ss.components != 1 || ts.components != 1 {
             return Err(InputError::TopologyMismatch(format!(
                 "both meshes must be connected (source has {} components, target {})",
@@ -138,17 +146,17 @@ impl JobSpec {
         let mut out = Vec::with_capacity(n);
         let (mut seen_s, mut seen_t) = (std::collections::HashMap::new(), std::collections::HashMap::new());
         for (i, &[s, t]) in self.anchors.iter().enumerate() {
-            if s >= source.n_vertices() as u64 {
+            if s >= ss.vertices as u64 {
                 return Err(InputError::Anchors(format!(
                     "anchor {i}: source vertex {s} is out of range (source has {} vertices)",
-                    source.n_vertices()
+                    ss.vertices
                 ))
                 .into());
             }
-            if t >= target.n_vertices() as u64 {
+            if t >= ts.vertices as u64 {
                 return Err(InputError::Anchors(format!(
                     "anchor {i}: target vertex {t} is out of range (target has {} vertices)",
-                    target.n_vertices()
+                    ts.vertices
                 ))
                 .into());
             }

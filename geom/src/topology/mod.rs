@@ -15,7 +15,7 @@ use crate::mesh::Mesh;
 use serde::Serialize;
 
 /// Topological and size summary of a mesh (the body of `surfmap inspect`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct Summary {
     pub vertices: usize,
     pub faces: usize,

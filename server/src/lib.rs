@@ -1,0 +1,57 @@
+//! The job server: axum REST and tonic gRPC served on one port, two thin faces over one
+//! [`service::JobService`]; plus the janitor that requeues expired leases. The binary also runs
+//! in-process workers (`surfmap_worker`).
+
+pub mod auth;
+pub mod error;
+pub mod grpc;
+pub mod openapi;
+pub mod rest;
+pub mod service;
+pub mod telemetry;
+pub mod views;
+
+use std::time::Duration;
+use surfmap_proto::v1::surfmap_server::SurfmapServer;
+
+/// What every handler shares.
+#[derive(Debug, Clone)]
+pub struct AppState {
+    pub service: service::JobService,
+    pub auth: auth::Auth,
+}
+
+/// REST and gRPC (with health and reflection) on one router.
+pub fn app(state: AppState) -> axum::Router {
+    telemetry::prometheus();
+    let limit = state.service.limits.max_body_bytes;
+    let grpc = SurfmapServer::new(grpc::GrpcApi { state: state.clone() })
+        .max_decoding_message_size(limit)
+        .max_encoding_message_size(limit);
+    let (reporter, health) = tonic_health::server::health_reporter();
+    tokio::spawn(async move { reporter.set_serving::<SurfmapServer<grpc::GrpcApi>>().await });
+    let mut routes = tonic::service::Routes::new(grpc).add_service(health);
+    match tonic_reflection::server::Builder::configure()
+        .register_encoded_file_descriptor_set(surfmap_proto::FILE_DESCRIPTOR_SET)
+        .build_v1()
+    {
+        Ok(r) => routes = routes.add_service(r),
+        Err(e) => tracing::warn!("gRPC reflection unavailable: {e}"),
+    }
+    rest::router(state).merge(routes.into_axum_router())
+}
+
+/// Requeues expired leases every `period` until `shutdown`.
+pub async fn janitor(store: surfmap_store::Store, period: Duration, mut shutdown: surfmap_worker::Shutdown) {
+    loop {
+        match store.requeue_expired().await {
+            Ok(s) if s != Default::default() => tracing::info!(?s, "janitor: expired leases swept"),
+            Ok(_) => {}
+            Err(e) => tracing::warn!("janitor: {e}"),
+        }
+        tokio::select! {
+            _ = tokio::time::sleep(period) => {}
+            _ = shutdown.changed() => return,
+        }
+    }
+}

@@ -1,0 +1,119 @@
+//! `surfmap-server`: REST + gRPC on one port, the janitor, and N in-process workers
+//! (`--workers 0` makes it API only). Prints `listening on ADDR` as its first stdout line.
+
+use clap::Parser;
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Duration;
+use surfmap_server::service::{JobService, Limits};
+use surfmap_server::{AppState, auth::Auth};
+use surfmap_worker::{Worker, WorkerConfig};
+
+#[derive(Debug, Parser)]
+#[command(name = "surfmap-server", version, about = "The surfmap job server (REST and gRPC on one port)")]
+struct Args {
+    /// Address to bind; port 0 picks a free one.
+    #[arg(long, env = "SURFMAP_LISTEN", default_value = "127.0.0.1:8080")]
+    listen: String,
+    /// sqlite://PATH (created on first run) or postgres://…
+    #[arg(long, env = "SURFMAP_DATABASE_URL", default_value = "sqlite://surfmap.db")]
+    database_url: String,
+    /// Directory of the content-addressed blobs (meshes, artifacts).
+    #[arg(long, env = "SURFMAP_DATA_DIR", default_value = "./surfmap-data")]
+    data_dir: PathBuf,
+    /// In-process workers [default: number of cores]; 0 serves the API only.
+    #[arg(long, env = "SURFMAP_WORKERS")]
+    workers: Option<usize>,
+    /// Bearer token a client must present (repeatable). With tokens, clients see only their own jobs.
+    #[arg(long = "api-token", env = "SURFMAP_API_TOKENS", value_delimiter = ',')]
+    api_tokens: Vec<String>,
+    /// Largest request body in MiB.
+    #[arg(long, env = "SURFMAP_MAX_BODY_MB", default_value_t = 256)]
+    max_body_mb: usize,
+    /// Largest mesh in vertices.
+    #[arg(long, env = "SURFMAP_MAX_VERTICES", default_value_t = 2_000_000)]
+    max_vertices: u64,
+    /// Attempts per job before an expired lease fails it.
+    #[arg(long, env = "SURFMAP_MAX_ATTEMPTS", default_value_t = 3)]
+    max_attempts: i64,
+    /// Lease length of the in-process workers, in seconds.
+    #[arg(long, env = "SURFMAP_LEASE_SECS", default_value_t = 30.0)]
+    lease_secs: f64,
+    /// Wall-clock limit per job, in seconds.
+    #[arg(long, env = "SURFMAP_TIME_LIMIT_SECS", default_value_t = 1800)]
+    time_limit_secs: u64,
+    /// On SIGTERM, how long running jobs may finish before their leases are released.
+    #[arg(long, env = "SURFMAP_SHUTDOWN_GRACE_SECS", default_value_t = 60)]
+    shutdown_grace_secs: u64,
+}
+
+#[tokio::main]
+async fn main() -> std::process::ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info,sqlx=warn".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match run(Args::parse()).await {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("surfmap-server: {e:#}");
+            std::process::ExitCode::from(1)
+        }
+    }
+}
+
+async fn run(a: Args) -> anyhow::Result<()> {
+    if !(a.lease_secs.is_finite() && a.lease_secs > 0.0) || a.max_attempts < 1 {
+        anyhow::bail!("--lease-secs must be positive and --max-attempts at least 1");
+    }
+    surfmap_server::telemetry::prometheus();
+    let store = surfmap_store::Store::connect(&a.database_url).await?;
+    let blobs = surfmap_store::BlobStore::open(&a.data_dir)?;
+    let limits = Limits {
+        max_body_bytes: a.max_body_mb.saturating_mul(1 << 20),
+        max_vertices: a.max_vertices,
+        max_attempts: a.max_attempts,
+        ..Limits::default()
+    };
+    let service = JobService { store: store.clone(), blobs: blobs.clone(), limits };
+    let state = AppState { service, auth: Auth::new(&a.api_tokens) };
+    let listener = tokio::net::TcpListener::bind(&a.listen).await?;
+    let addr = listener.local_addr()?;
+    println!("listening on {addr}");
+    std::io::stdout().flush()?;
+    tracing::info!(%addr, store = store.dialect(), auth = state.auth.enabled(), "serving REST and gRPC");
+
+    let (tx, rx) = tokio::sync::watch::channel(false);
+    let lease = Duration::from_secs_f64(a.lease_secs);
+    let mut tasks = Vec::new();
+    tasks.push(tokio::spawn(surfmap_server::janitor(store.clone(), (lease / 2).max(Duration::from_millis(200)), rx.clone())));
+    let n = a.workers.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    for i in 0..n {
+        let config = WorkerConfig {
+            id: format!("{}-w{i}", WorkerConfig::default_id()),
+            lease,
+            time_limit: Duration::from_secs(a.time_limit_secs),
+            max_vertices: a.max_vertices,
+            shutdown_grace: Duration::from_secs(a.shutdown_grace_secs),
+            ..WorkerConfig::default()
+        };
+        let w = Worker { store: store.clone(), blobs: blobs.clone(), config };
+        let rx = rx.clone();
+        tasks.push(tokio::spawn(async move { w.run(rx).await }));
+    }
+    tracing::info!(workers = n, "in-process workers started");
+    axum::serve(listener, surfmap_server::app(state))
+        .with_graceful_shutdown(async move {
+            surfmap_worker::shutdown_signal().await;
+            tracing::info!("shutdown requested: no new requests or jobs");
+            let _ = tx.send(true);
+        })
+        .await?;
+    for t in tasks {
+        let _ = t.await;
+    }
+    tracing::info!("stopped cleanly");
+    Ok(())
+}

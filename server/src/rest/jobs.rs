@@ -1,0 +1,132 @@
+//! Job routes: submit (JSON or multipart), get, list, cancel, and SSE progress.
+
+use super::{Owner, P, Q, is_multipart, multipart_error, read_limited};
+use crate::AppState;
+use crate::error::{ApiError, ErrorBody};
+use crate::service::parse_spec;
+use crate::views::{JobPage, JobView, SubmitJob, job_view};
+use axum::Json;
+use axum::extract::{FromRequest, Multipart, Request, State};
+use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
+use axum::response::sse::{Event, KeepAlive, Sse};
+use axum::response::{IntoResponse, Response};
+use futures::{Stream, StreamExt};
+use std::convert::Infallible;
+use surfmap_store::{BlobStore, JobFilter, JobState};
+
+/// Filters and paging of `GET /v1/jobs`.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+pub struct ListQuery {
+    /// queued | running | succeeded | failed | cancelled
+    pub state: Option<String>,
+    pub method: Option<String>,
+    /// `next_cursor` of the previous page.
+    pub cursor: Option<String>,
+    /// 1 to 500; 50 by default.
+    pub limit: Option<i64>,
+}
+
+/// A multipart part: a mesh id, or mesh bytes to upload first (a part with a file name, or
+/// anything that is not a 64-hex-digit id).
+async fn mesh_part(st: &AppState, owner: &str, bytes: &[u8], file_name: Option<String>) -> Result<String, ApiError> {
+    let text = std::str::from_utf8(bytes).map(str::trim).unwrap_or("");
+    if file_name.is_none() && BlobStore::valid_key(text) {
+        return Ok(text.to_string());
+    }
+    let hint = file_name.and_then(|f| f.rsplit_once('.').map(|(_, e)| e.to_ascii_lowercase()));
+    let hint = hint.filter(|e| ["obj", "off", "ply", "stl"].contains(&e.as_str()));
+    Ok(st.service.upload_mesh(owner, bytes.to_vec(), hint.as_deref()).await?.id)
+}
+
+async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<(String, String, Vec<u8>), ApiError> {
+    let (mut source, mut target, mut spec) = (None, None, None);
+    while let Some(field) = mp.next_field().await.map_err(multipart_error)? {
+        let name = field.name().unwrap_or_default().to_string();
+        let file = field.file_name().map(str::to_string);
+        let bytes = field.bytes().await.map_err(multipart_error)?;
+        match name.as_str() {
+            "source" => source = Some(mesh_part(st, owner, &bytes, file).await?),
+            "target" => target = Some(mesh_part(st, owner, &bytes, file).await?),
+            "spec" => spec = Some(bytes.to_vec()),
+            other => return Err(ApiError::bad_request("invalid_multipart", format!("unexpected part {other:?}"))),
+        }
+    }
+    let missing = |p: &str| ApiError::bad_request("invalid_multipart", format!("missing part {p:?}"));
+    Ok((source.ok_or_else(|| missing("source"))?, target.ok_or_else(|| missing("target"))?, spec.ok_or_else(|| missing("spec"))?))
+}
+
+/// Validates a job against its meshes and queues it.
+#[utoipa::path(post, path = "/v1/jobs", tag = "jobs", request_body = SubmitJob,
+    params(("Idempotency-Key" = Option<String>, Header, description = "retries with the same key return the same job")),
+    responses((status = 202, body = JobView, headers(("Location" = String))),
+        (status = 400, description = "bad spec or unknown method", body = ErrorBody),
+        (status = 404, description = "unknown mesh", body = ErrorBody),
+        (status = 409, description = "idempotency key reused", body = ErrorBody),
+        (status = 422, description = "genus mismatch, anchors out of range", body = ErrorBody)))]
+pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Request) -> Result<Response, ApiError> {
+    let key = req.headers().get("idempotency-key").and_then(|v| v.to_str().ok()).map(str::to_string);
+    let (source, target, spec) = if is_multipart(req.headers()) {
+        let mp = Multipart::from_request(req, &st).await.map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;
+        multipart_job(&st, &owner, mp).await?
+    } else {
+        let (parts, body) = req.into_parts();
+        let bytes = read_limited(&parts.headers, body, st.service.limits.max_body_bytes).await?;
+        let s: SubmitJob = serde_json::from_slice(&bytes)
+            .map_err(|e| ApiError::bad_request("invalid_request", format!("expected {{source, target, spec}}: {e}")))?;
+        (s.source, s.target, serde_json::to_vec(&s.spec).map_err(ApiError::internal)?)
+    };
+    let spec = parse_spec(&spec)?;
+    let (job, created) = st.service.submit(&owner, &source, &target, &spec, key).await?;
+    let mut headers = HeaderMap::new();
+    if let Ok(v) = HeaderValue::from_str(&format!("/v1/jobs/{}", job.id)) {
+        headers.insert(header::LOCATION, v);
+    }
+    if !created {
+        headers.insert("idempotent-replayed", HeaderValue::from_static("true"));
+    }
+    Ok((StatusCode::ACCEPTED, headers, Json(job_view(&job))).into_response())
+}
+
+/// State, stage, progress, attempts, timestamps, error and result links of a job.
+#[utoipa::path(get, path = "/v1/jobs/{id}", tag = "jobs", params(("id" = String, Path)),
+    responses((status = 200, body = JobView), (status = 404, body = ErrorBody)))]
+pub async fn get_job(State(st): State<AppState>, Owner(owner): Owner, P(id): P<String>) -> Result<Json<JobView>, ApiError> {
+    Ok(Json(job_view(&st.service.get(&owner, &id).await?)))
+}
+
+/// Jobs, newest first, with filters and cursor paging.
+#[utoipa::path(get, path = "/v1/jobs", tag = "jobs", params(ListQuery), responses((status = 200, body = JobPage)))]
+pub async fn list_jobs(State(st): State<AppState>, Owner(owner): Owner, Q(q): Q<ListQuery>) -> Result<Json<JobPage>, ApiError> {
+    let state = match q.state.as_deref() {
+        None | Some("") => None,
+        Some(s) => Some(JobState::parse(s).ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?),
+    };
+    let filter = JobFilter { state, method: q.method.filter(|m| !m.is_empty()), before: q.cursor.filter(|c| !c.is_empty()), limit: q.limit.unwrap_or(50) };
+    let (jobs, next_cursor) = st.service.list(&owner, filter).await?;
+    Ok(Json(JobPage { jobs: jobs.iter().map(job_view).collect(), next_cursor }))
+}
+
+/// Cancels a queued job at once; a running job stops at its next check.
+#[utoipa::path(post, path = "/v1/jobs/{id}/cancel", tag = "jobs", params(("id" = String, Path)),
+    responses((status = 200, body = JobView), (status = 404, body = ErrorBody)))]
+pub async fn cancel_job(State(st): State<AppState>, Owner(owner): Owner, P(id): P<String>) -> Result<Json<JobView>, ApiError> {
+    Ok(Json(job_view(&st.service.cancel(&owner, &id).await?)))
+}
+
+/// Server-sent events: one `job` event (a JobView) per change of state, stage or progress;
+/// the stream ends after a terminal state.
+#[utoipa::path(get, path = "/v1/jobs/{id}/events", tag = "jobs", params(("id" = String, Path)),
+    responses((status = 200, content_type = "text/event-stream", description = "`event: job` with a JobView as data"),
+        (status = 404, body = ErrorBody)))]
+pub async fn job_events(
+    State(st): State<AppState>,
+    Owner(owner): Owner,
+    P(id): P<String>,
+) -> Result<Sse<impl Stream<Item = Result<Event, Infallible>>>, ApiError> {
+    let first = st.service.get(&owner, &id).await?;
+    let stream = st.service.watch(owner, first).map(|job| {
+        let ev = Event::default().event("job");
+        Ok(ev.json_data(job_view(&job)).unwrap_or_else(|_| Event::default().event("error")))
+    });
+    Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
+}

@@ -1,0 +1,51 @@
+//! `POST /v1/meshes`: a raw body or a multipart file part.
+
+use super::{Owner, Q, is_multipart, multipart_error, read_limited};
+use crate::AppState;
+use crate::error::{ApiError, ErrorBody};
+use crate::views::MeshView;
+use axum::Json;
+use axum::extract::{FromRequest, Multipart, Request, State};
+use axum::http::StatusCode;
+
+/// `?format=` for content that is ambiguous.
+#[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+pub struct FormatQuery {
+    /// obj, off, ply or stl; only used when the content does not tell.
+    pub format: Option<String>,
+}
+
+/// The first file part of a multipart body and the format its file name suggests.
+pub async fn first_file(mut mp: Multipart) -> Result<(Vec<u8>, Option<String>), ApiError> {
+    while let Some(field) = mp.next_field().await.map_err(multipart_error)? {
+        let ext = field.file_name().and_then(|f| f.rsplit_once('.')).map(|(_, e)| e.to_ascii_lowercase());
+        let named = matches!(field.name(), Some("file" | "mesh"));
+        if named || ext.is_some() {
+            let bytes = field.bytes().await.map_err(multipart_error)?;
+            return Ok((bytes.to_vec(), ext));
+        }
+    }
+    Err(ApiError::bad_request("invalid_multipart", "no file part (name it \"file\")"))
+}
+
+/// Uploads one mesh (OBJ, OFF, PLY or STL); returns its content address and summary.
+#[utoipa::path(post, path = "/v1/meshes", tag = "meshes", params(FormatQuery),
+    request_body(content = Vec<u8>, content_type = "application/octet-stream", description = "mesh bytes, or multipart with a `file` part"),
+    responses((status = 201, body = MeshView), (status = 413, body = ErrorBody), (status = 422, description = "invalid mesh", body = ErrorBody)))]
+pub async fn upload_mesh(
+    State(st): State<AppState>,
+    Owner(owner): Owner,
+    Q(q): Q<FormatQuery>,
+    req: Request,
+) -> Result<(StatusCode, Json<MeshView>), ApiError> {
+    let (bytes, ext) = if is_multipart(req.headers()) {
+        let mp = Multipart::from_request(req, &st).await.map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;
+        first_file(mp).await?
+    } else {
+        let (parts, body) = req.into_parts();
+        (read_limited(&parts.headers, body, st.service.limits.max_body_bytes).await?.to_vec(), None)
+    };
+    let hint = q.format.or(ext.filter(|e| ["obj", "off", "ply", "stl"].contains(&e.as_str())));
+    let view = st.service.upload_mesh(&owner, bytes, hint.as_deref()).await?;
+    Ok((StatusCode::CREATED, Json(view)))
+}

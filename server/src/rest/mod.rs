@@ -1,0 +1,106 @@
+//! The REST face: routes, the owner extractor, limited body reading, and JSON rejections.
+//! Each handler is a few lines around one `JobService` call.
+
+pub mod artifacts;
+pub mod jobs;
+pub mod meshes;
+pub mod ops;
+
+use crate::AppState;
+use crate::error::ApiError;
+use axum::Router;
+use axum::body::{Body, Bytes};
+use axum::extract::{DefaultBodyLimit, FromRequestParts};
+use axum::http::request::Parts;
+use axum::http::{HeaderMap, header};
+use axum::routing::{get, post};
+
+/// The client's owner id (see `auth`).
+pub struct Owner(pub String);
+
+impl FromRequestParts<AppState> for Owner {
+    type Rejection = ApiError;
+    async fn from_request_parts(parts: &mut Parts, st: &AppState) -> Result<Self, ApiError> {
+        let h = parts.headers.get(header::AUTHORIZATION).and_then(|v| v.to_str().ok());
+        st.auth.owner(h).map(Owner)
+    }
+}
+
+/// `Query` with a JSON rejection.
+pub struct Q<T>(pub T);
+
+impl<T: serde::de::DeserializeOwned + Send, S: Send + Sync> FromRequestParts<S> for Q<T> {
+    type Rejection = ApiError;
+    async fn from_request_parts(parts: &mut Parts, st: &S) -> Result<Self, ApiError> {
+        axum::extract::Query::<T>::from_request_parts(parts, st)
+            .await
+            .map(|q| Q(q.0))
+            .map_err(|e| ApiError::bad_request("invalid_query", e.body_text()))
+    }
+}
+
+/// `Path` with a JSON rejection.
+pub struct P<T>(pub T);
+
+impl<T: serde::de::DeserializeOwned + Send, S: Send + Sync> FromRequestParts<S> for P<T> {
+    type Rejection = ApiError;
+    async fn from_request_parts(parts: &mut Parts, st: &S) -> Result<Self, ApiError> {
+        axum::extract::Path::<T>::from_request_parts(parts, st)
+            .await
+            .map(|p| P(p.0))
+            .map_err(|e| ApiError::bad_request("invalid_path", e.body_text()))
+    }
+}
+
+/// Refuses a declared length over `limit` at once, then reads at most `limit` bytes.
+///
+/// # Errors
+/// 413 `payload_too_large`.
+pub async fn read_limited(headers: &HeaderMap, body: Body, limit: usize) -> Result<Bytes, ApiError> {
+    let declared = headers.get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.parse::<u64>().ok());
+    if declared.is_some_and(|n| n > limit as u64) {
+        return Err(ApiError::too_large(format!("request body of {} bytes exceeds the limit of {limit}", declared.unwrap_or(0))));
+    }
+    axum::body::to_bytes(body, limit)
+        .await
+        .map_err(|e| ApiError::too_large(format!("request body exceeds the limit of {limit} bytes ({e})")))
+}
+
+/// True for a `multipart/form-data` request.
+pub fn is_multipart(headers: &HeaderMap) -> bool {
+    headers.get(header::CONTENT_TYPE).and_then(|v| v.to_str().ok()).is_some_and(|v| v.starts_with("multipart/form-data"))
+}
+
+/// Multipart errors as JSON (413 when over the body limit).
+pub fn multipart_error(e: axum::extract::multipart::MultipartError) -> ApiError {
+    let status = e.status();
+    if status == axum::http::StatusCode::PAYLOAD_TOO_LARGE {
+        ApiError::too_large(e.body_text())
+    } else {
+        ApiError::bad_request("invalid_multipart", e.body_text())
+    }
+}
+
+async fn not_found() -> ApiError {
+    ApiError::not_found("route_not_found", "no such route")
+}
+
+/// The REST routes.
+pub fn router(state: AppState) -> Router {
+    let limit = state.service.limits.max_body_bytes;
+    Router::new()
+        .route("/v1/meshes", post(meshes::upload_mesh))
+        .route("/v1/jobs", post(jobs::submit_job).get(jobs::list_jobs))
+        .route("/v1/jobs/{id}", get(jobs::get_job))
+        .route("/v1/jobs/{id}/cancel", post(jobs::cancel_job))
+        .route("/v1/jobs/{id}/events", get(jobs::job_events))
+        .route("/v1/jobs/{id}/artifacts", get(artifacts::list_artifacts))
+        .route("/v1/jobs/{id}/artifacts/{name}", get(artifacts::get_artifact))
+        .route("/openapi.json", get(ops::openapi))
+        .route("/healthz", get(ops::healthz))
+        .route("/readyz", get(ops::readyz))
+        .route("/metrics", get(ops::metrics))
+        .fallback(not_found)
+        .layer(DefaultBodyLimit::max(limit))
+        .with_state(state)
+}

@@ -1,0 +1,41 @@
+//! Operations routes: liveness, readiness, Prometheus metrics and the OpenAPI document.
+
+use crate::AppState;
+use crate::error::ApiError;
+use axum::Json;
+use axum::extract::State;
+use axum::http::header;
+use axum::response::IntoResponse;
+use utoipa::OpenApi;
+
+/// Liveness: the process answers.
+#[utoipa::path(get, path = "/healthz", tag = "ops", responses((status = 200, description = "alive")))]
+pub async fn healthz() -> Json<serde_json::Value> {
+    Json(serde_json::json!({"status": "ok"}))
+}
+
+/// Readiness: the store answers.
+#[utoipa::path(get, path = "/readyz", tag = "ops", responses((status = 200, description = "ready"), (status = 503, description = "store unavailable")))]
+pub async fn readyz(State(st): State<AppState>) -> Result<Json<serde_json::Value>, ApiError> {
+    st.service.store.ping().await?;
+    Ok(Json(serde_json::json!({"status": "ready", "store": st.service.store.dialect()})))
+}
+
+/// Prometheus text: queue depth, jobs by state, stage and job duration histograms by method,
+/// failures by code, rejected requests by code.
+#[utoipa::path(get, path = "/metrics", tag = "ops", responses((status = 200, content_type = "text/plain", description = "Prometheus exposition")))]
+pub async fn metrics(State(st): State<AppState>) -> Result<impl IntoResponse, ApiError> {
+    for (state, n) in st.service.store.count_by_state().await? {
+        metrics::gauge!("surfmap_jobs", "state" => state.as_str()).set(n as f64);
+        if state == surfmap_store::JobState::Queued {
+            metrics::gauge!("surfmap_queue_depth").set(n as f64);
+        }
+    }
+    Ok(([(header::CONTENT_TYPE, "text/plain; version=0.0.4")], crate::telemetry::prometheus().render()))
+}
+
+/// The OpenAPI 3.1 document of this API.
+#[utoipa::path(get, path = "/openapi.json", tag = "ops", responses((status = 200, description = "OpenAPI document")))]
+pub async fn openapi() -> Json<utoipa::openapi::OpenApi> {
+    Json(crate::openapi::ApiDoc::openapi())
+}

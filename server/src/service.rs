@@ -1,0 +1,238 @@
+//! `JobService`: the operations behind both faces (REST and gRPC). Handlers translate their
+//! request into one call here and the answer back; nothing else decides anything.
+
+use crate::error::ApiError;
+use crate::views::MeshView;
+use futures::Stream;
+use geom::io::{Format, ReadOptions};
+use geom::mesh::MeshLimits;
+use geom::pipeline::{JobSpec, Method};
+use std::time::Duration;
+use surfmap_store::{ArtifactRef, BlobStore, JobFilter, JobRecord, MeshRecord, NewJob, Store, now_ms};
+
+/// Sizes and retry policy the service enforces.
+#[derive(Debug, Clone)]
+pub struct Limits {
+    /// Largest request body (mesh uploads, multipart jobs), enforced while streaming.
+    pub max_body_bytes: usize,
+    /// Largest mesh, in vertices (checked from headers before allocation).
+    pub max_vertices: u64,
+    /// Attempts a job gets before an expired lease fails it.
+    pub max_attempts: i64,
+    /// How often watchers (SSE, WatchJob) look at the job.
+    pub watch_interval: Duration,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            max_body_bytes: 256 << 20,
+            max_vertices: 2_000_000,
+            max_attempts: 3,
+            watch_interval: Duration::from_millis(200),
+        }
+    }
+}
+
+/// The one service both faces call.
+#[derive(Debug, Clone)]
+pub struct JobService {
+    pub store: Store,
+    pub blobs: BlobStore,
+    pub limits: Limits,
+}
+
+/// The methods a job may name, in the order the docs list them.
+pub const METHODS: [&str; 2] = ["voronoi", "greedy"];
+
+fn parse_format(hint: Option<&str>) -> Result<Option<Format>, ApiError> {
+    Ok(match hint.map(str::to_ascii_lowercase).as_deref() {
+        None | Some("") => None,
+        Some("obj") => Some(Format::Obj),
+        Some("off") => Some(Format::Off),
+        Some("ply") => Some(Format::Ply),
+        Some("stl") => Some(Format::Stl),
+        Some(other) => {
+            return Err(ApiError::bad_request("unknown_format", format!("format {other:?} is not obj, off, ply or stl")));
+        }
+    })
+}
+
+/// Parses a spec, naming an unknown method before any other field.
+///
+/// # Errors
+/// `unknown_method` or `invalid_spec` (400).
+pub fn parse_spec(bytes: &[u8]) -> Result<JobSpec, ApiError> {
+    let v: serde_json::Value = serde_json::from_slice(bytes)
+        .map_err(|e| ApiError::bad_request("invalid_spec", format!("spec is not JSON: {e}")))?;
+    match v.get("method") {
+        Some(serde_json::Value::String(m)) if !METHODS.contains(&m.as_str()) => {
+            return Err(ApiError::bad_request(
+                "unknown_method",
+                format!("unknown method {m:?}; available: {}", METHODS.join(", ")),
+            ));
+        }
+        None => return Err(ApiError::bad_request("invalid_spec", "spec has no \"method\"")),
+        _ => {}
+    }
+    Ok(serde_json::from_value::<JobSpec>(v).map_err(|e| geom::Error::from(geom::InputError::Spec(e.to_string())))?)
+}
+
+impl JobService {
+    /// Parses, validates and stores one mesh.
+    ///
+    /// # Errors
+    /// 422 with the reader's code for a bad mesh; 413 for one over the vertex cap.
+    pub async fn upload_mesh(&self, owner: &str, bytes: Vec<u8>, hint: Option<&str>) -> Result<MeshView, ApiError> {
+        let hint = parse_format(hint)?;
+        let limits = MeshLimits { max_vertices: self.limits.max_vertices, max_faces: 2 * self.limits.max_vertices + 8 };
+        let (bytes, parsed) = tokio::task::spawn_blocking(move || {
+            let r = geom::io::read(&bytes, &ReadOptions { limits, hint });
+            (bytes, r.map(|r| (r.format, geom::topology::summary(&r.mesh), r.warnings)))
+        })
+        .await
+        .map_err(ApiError::internal)?;
+        let (format, summary, warnings) = parsed?;
+        let id = self.blobs.put(&bytes).await.map_err(ApiError::internal)?;
+        let summary = serde_json::to_value(&summary).map_err(ApiError::internal)?;
+        let rec = MeshRecord {
+            owner: owner.to_string(),
+            id: id.clone(),
+            format: format.name().to_string(),
+            size_bytes: bytes.len() as i64,
+            summary: summary.to_string(),
+            created_at: now_ms(),
+        };
+        self.store.put_mesh(&rec).await?;
+        Ok(MeshView {
+            id,
+            format: rec.format,
+            size_bytes: rec.size_bytes,
+            summary,
+            warnings: warnings.into_iter().map(|w| w.message).collect(),
+        })
+    }
+
+    async fn summary(&self, owner: &str, role: &str, id: &str) -> Result<geom::topology::Summary, ApiError> {
+        let m = self.store.get_mesh(owner, id).await?.ok_or_else(|| {
+            ApiError::not_found("mesh_not_found", format!("{role} mesh {id:?} is not known; upload it with POST /v1/meshes"))
+        })?;
+        serde_json::from_str(&m.summary).map_err(ApiError::internal)
+    }
+
+    /// Validates a job against its meshes and queues it. Returns the job and whether it is new
+    /// (false: an earlier request with the same idempotency key).
+    ///
+    /// # Errors
+    /// 400 bad spec or unknown method; 404 unknown mesh; 422 genus mismatch, bad anchors;
+    /// 409 idempotency key reused for another request.
+    pub async fn submit(
+        &self,
+        owner: &str,
+        source: &str,
+        target: &str,
+        spec: &JobSpec,
+        idempotency_key: Option<String>,
+    ) -> Result<(JobRecord, bool), ApiError> {
+        let ss = self.summary(owner, "source", source).await?;
+        let ts = self.summary(owner, "target", target).await?;
+        spec.check(&ss, &ts)?;
+        let method = match spec.method {
+            Method::Voronoi => "voronoi",
+            Method::Greedy => "greedy",
+        };
+        let job = NewJob {
+            owner: owner.to_string(),
+            idempotency_key: idempotency_key.filter(|k| !k.is_empty()),
+            method: method.to_string(),
+            spec: serde_json::to_string(spec).map_err(ApiError::internal)?,
+            source: source.to_string(),
+            target: target.to_string(),
+            max_attempts: self.limits.max_attempts,
+        };
+        let r = self.store.insert_job(&job).await?;
+        if r.1 {
+            metrics::counter!("surfmap_jobs_submitted_total", "method" => method).increment(1);
+        }
+        Ok(r)
+    }
+
+    /// # Errors
+    /// 404 for a job `owner` cannot see.
+    pub async fn get(&self, owner: &str, id: &str) -> Result<JobRecord, ApiError> {
+        self.store.get_job(owner, id).await?.ok_or_else(|| ApiError::not_found("job_not_found", format!("no job {id:?}")))
+    }
+
+    /// A page of jobs and the cursor of the next one.
+    ///
+    /// # Errors
+    /// Store failures.
+    pub async fn list(&self, owner: &str, mut filter: JobFilter) -> Result<(Vec<JobRecord>, Option<String>), ApiError> {
+        filter.limit = if filter.limit <= 0 { 50 } else { filter.limit.min(500) };
+        let jobs = self.store.list_jobs(owner, &filter).await?;
+        let next = (jobs.len() as i64 == filter.limit).then(|| jobs.last().map(|j| j.id.clone())).flatten();
+        Ok((jobs, next))
+    }
+
+    /// # Errors
+    /// 404 for an unknown job.
+    pub async fn cancel(&self, owner: &str, id: &str) -> Result<JobRecord, ApiError> {
+        self.store.cancel_job(owner, id).await?.ok_or_else(|| ApiError::not_found("job_not_found", format!("no job {id:?}")))
+    }
+
+    /// One artifact's record and bytes. The name must be one the job lists: a name with a
+    /// path separator or `..` is refused before any lookup.
+    ///
+    /// # Errors
+    /// 400 `invalid_artifact_name`; 404 unknown job or artifact.
+    pub async fn artifact(&self, owner: &str, id: &str, name: &str) -> Result<(ArtifactRef, Vec<u8>), ApiError> {
+        if name.is_empty() || name.contains(['/', '\\', '\0']) || name.contains("..") {
+            return Err(ApiError::bad_request("invalid_artifact_name", format!("artifact name {name:?} is not a plain file name")));
+        }
+        let job = self.get(owner, id).await?;
+        let a = job.artifacts.iter().find(|a| a.name == name).cloned().ok_or_else(|| {
+            ApiError::not_found("artifact_not_found", format!("job {id} has no artifact {name:?} (state {})", job.state.as_str()))
+        })?;
+        let bytes = self.blobs.get(&a.sha256).await.map_err(ApiError::internal)?.ok_or_else(|| {
+            ApiError::internal(format!("blob {} of job {id} is missing", a.sha256))
+        })?;
+        Ok((a, bytes))
+    }
+
+    /// The job every time its state, stage, progress (to 0.1%) or attempts change, ending
+    /// after a terminal state. The first item is the job as it is now.
+    pub fn watch(&self, owner: String, first: JobRecord) -> impl Stream<Item = JobRecord> + Send + 'static + use<> {
+        struct S {
+            svc: JobService,
+            owner: String,
+            id: String,
+            first: Option<JobRecord>,
+            last: Option<(String, String, i64, i64)>,
+            done: bool,
+        }
+        let s = S { svc: self.clone(), owner, id: first.id.clone(), first: Some(first), last: None, done: false };
+        futures::stream::unfold(s, |mut s| async move {
+            if s.done {
+                return None;
+            }
+            loop {
+                let job = match s.first.take() {
+                    Some(j) => j,
+                    None => {
+                        tokio::time::sleep(s.svc.limits.watch_interval).await;
+                        match s.svc.store.get_job(&s.owner, &s.id).await {
+                            Ok(Some(j)) => j,
+                            _ => return None,
+                        }
+                    }
+                };
+                let key = (job.state.as_str().to_string(), job.stage.clone(), (job.progress * 1000.0) as i64, job.attempts);
+                if s.last.as_ref() != Some(&key) {
+                    s.last = Some(key);
+                    s.done = job.state.is_terminal();
+                    return Some((job, s));
+                }
+            }
+        })
+    }
+}

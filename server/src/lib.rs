@@ -38,7 +38,9 @@ pub fn app(state: AppState) -> axum::Router {
         Ok(r) => routes = routes.add_service(r),
         Err(e) => tracing::warn!("gRPC reflection unavailable: {e}"),
     }
-    rest::router(state).merge(routes.into_axum_router())
+    // tonic's router brings a fallback (gRPC `unimplemented`); replace it with the JSON 404
+    // so the merged router has exactly one.
+    rest::router(state).merge(routes.into_axum_router().fallback(rest::not_found))
 }
 
 /// Requeues expired leases every `period` until `shutdown`.

@@ -53,6 +53,8 @@ pub struct JobView {
     pub source: String,
     pub target: String,
     pub cancel_requested: bool,
+    /// The worker holding the lease, or the one that finished the job.
+    pub worker: Option<String>,
     pub created_at_ms: i64,
     pub updated_at_ms: i64,
     pub started_at_ms: Option<i64>,
@@ -114,6 +116,7 @@ pub fn job_view(j: &JobRecord) -> JobView {
         source: j.source.clone(),
         target: j.target.clone(),
         cancel_requested: j.cancel_requested,
+        worker: j.lease_owner.clone(),
         created_at_ms: j.created_at,
         updated_at_ms: j.updated_at,
         started_at_ms: j.started_at,

@@ -81,6 +81,7 @@ pub struct JobRecord {
     pub progress: f64,
     pub attempts: i64,
     pub max_attempts: i64,
+    /// The worker holding (or, once finished, that last held) the lease.
     pub lease_owner: Option<String>,
     pub lease_expires_at: Option<i64>,
     pub fence: i64,

@@ -317,7 +317,7 @@ impl Store {
         let n = on!(self, p => sqlx::query(
             "UPDATE jobs SET state = $3, stage = $3, progress = CASE WHEN $4 < 0 THEN progress ELSE $4 END, \
              error_code = $5, error_message = $6, result = $7, artifacts = $8, finished_at = $9, updated_at = $9, \
-             lease_owner = NULL, lease_expires_at = NULL WHERE id = $1 AND fence = $2 AND state = 'running'")
+             lease_expires_at = NULL WHERE id = $1 AND fence = $2 AND state = 'running'")
             .bind(id).bind(fence).bind(state.as_str()).bind(progress).bind(code).bind(message).bind(result)
             .bind(artifacts).bind(now).execute(p).await?.rows_affected());
         Ok(n == 1)

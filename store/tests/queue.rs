@@ -87,7 +87,8 @@ async fn a_stale_fence_cannot_write() {
         assert_eq!(done.result.as_deref(), Some("{\"by\":\"w2\"}"));
         assert_eq!(done.attempts, 2);
         assert_eq!(done.progress, 1.0);
-        assert!(done.lease_owner.is_none());
+        assert_eq!(done.lease_owner.as_deref(), Some("w2"), "the finishing worker is kept");
+        assert!(done.lease_expires_at.is_none());
     }
 }
 

@@ -81,7 +81,8 @@ pub fn multipart_error(e: axum::extract::multipart::MultipartError) -> ApiError 
     }
 }
 
-async fn not_found() -> ApiError {
+/// The JSON 404 of unknown routes (installed once, on the merged router).
+pub async fn not_found() -> ApiError {
     ApiError::not_found("route_not_found", "no such route")
 }
 
@@ -100,7 +101,6 @@ pub fn router(state: AppState) -> Router {
         .route("/healthz", get(ops::healthz))
         .route("/readyz", get(ops::readyz))
         .route("/metrics", get(ops::metrics))
-        .fallback(not_found)
         .layer(DefaultBodyLimit::max(limit))
         .with_state(state)
 }

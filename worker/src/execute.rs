@@ -181,8 +181,9 @@ impl Worker {
             return Ok("lease_lost".into());
         }
         let outcome = match result {
+            // A cancellation asked for while the last stage finished still wins.
+            _ if stops.user => Outcome::Cancelled,
             Ok((result, artifacts)) => Outcome::Succeeded { result, artifacts },
-            Err(geom::Error::Cancelled) if stops.user => Outcome::Cancelled,
             Err(geom::Error::Cancelled) if stops.timed_out => Outcome::Failed {
                 code: "time_limit".into(),
                 message: format!("the job ran longer than its limit of {} s", self.config.time_limit.as_secs()),

@@ -145,6 +145,7 @@ pub fn run_map(
     let visible = crate::crossparam::visible::make_visible(source, target, &mut s2t, &sa)?
         + crate::crossparam::visible::make_visible(target, source, &mut t2s, &ta)?;
     clock.lap("smooth");
+    progress.check()?;
     let result = MapResult { source_to_target: s2t, target_to_source: t2s };
     let on_target = result.source_to_target.embed(source, target)?;
     let on_source = result.target_to_source.embed(target, source)?;
@@ -157,6 +158,7 @@ pub fn run_map(
     });
     let (m1, m2) = (m1?, m2??);
     clock.lap("metrics");
+    progress.check()?;
     let mut report = MapReport {
         method: spec.method.name(),
         anchors: pairs.len(),

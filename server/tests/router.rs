@@ -1,0 +1,183 @@
+//! The router called directly (`oneshot`, no socket): uploads, submission, validation answers,
+//! paging, SSE, artifacts, metrics and the OpenAPI document, with jobs drained step by step by a
+//! worker in the test.
+
+use axum::body::Body;
+use axum::http::{Request, StatusCode};
+use geom::io::Format;
+use http_body_util::BodyExt;
+use serde_json::{Value, json};
+use surfmap_server::service::{JobService, Limits};
+use surfmap_server::{AppState, app, auth::Auth};
+use surfmap_store::{BlobStore, Store};
+use surfmap_worker::{Ran, Worker, WorkerConfig};
+use tower::ServiceExt;
+
+struct T {
+    _dir: tempfile::TempDir,
+    state: AppState,
+    worker: Worker,
+}
+
+async fn setup() -> T {
+    let dir = tempfile::tempdir().unwrap();
+    let store = Store::connect(&format!("sqlite://{}", dir.path().join("t.db").display())).await.unwrap();
+    let blobs = BlobStore::open(dir.path()).unwrap();
+    let limits = Limits { max_body_bytes: 1 << 20, ..Limits::default() };
+    let state = AppState { service: JobService { store: store.clone(), blobs: blobs.clone(), limits }, auth: Auth::new(&[]) };
+    let worker = Worker { store, blobs, config: WorkerConfig::default() };
+    T { _dir: dir, state, worker }
+}
+
+async fn call(t: &T, req: Request<Body>) -> (StatusCode, axum::http::HeaderMap, Vec<u8>) {
+    let r = app(t.state.clone()).oneshot(req).await.unwrap();
+    let (parts, body) = r.into_parts();
+    (parts.status, parts.headers, body.collect().await.unwrap().to_bytes().to_vec())
+}
+
+async fn json_call(t: &T, method: &str, uri: &str, body: Body) -> (StatusCode, Value) {
+    let (s, _, b) = call(t, Request::builder().method(method).uri(uri).body(body).unwrap()).await;
+    (s, serde_json::from_slice(&b).unwrap_or(Value::Null))
+}
+
+fn sphere_pair() -> (Vec<u8>, Vec<u8>) {
+    let s = geom::mesh::shapes::icosphere(3);
+    let t = s.with_positions(s.positions().iter().map(|p| geom::mesh::P3::new(p.x * 1.5, p.y * 0.8, p.z)).collect());
+    (geom::io::write(&s, Format::Off), geom::io::write(&t.unwrap(), Format::Obj))
+}
+
+fn spec() -> Value {
+    json!({"method": "voronoi", "anchors": [[0, 0], [2, 2], [5, 5], [7, 7], [9, 9], [11, 11]]})
+}
+
+#[tokio::test]
+async fn upload_submit_drain_and_download() {
+    let t = setup().await;
+    let (s, tg) = sphere_pair();
+    let (st, a) = json_call(&t, "POST", "/v1/meshes", Body::from(s.clone())).await;
+    assert_eq!(st, StatusCode::CREATED, "{a}");
+    assert_eq!((a["format"].as_str(), a["summary"]["genus"].as_i64()), (Some("off"), Some(0)));
+    assert_eq!(a["id"].as_str().unwrap(), BlobStore::key(&s));
+    let (_, b) = json_call(&t, "POST", "/v1/meshes", Body::from(tg)).await;
+    assert_eq!(b["format"], "obj");
+    let body = json!({"source": a["id"], "target": b["id"], "spec": spec()}).to_string();
+    let req = Request::post("/v1/jobs").header("content-type", "application/json").body(Body::from(body)).unwrap();
+    let (st, headers, job) = call(&t, req).await;
+    assert_eq!(st, StatusCode::ACCEPTED);
+    let job: Value = serde_json::from_slice(&job).unwrap();
+    let id = job["id"].as_str().unwrap().to_string();
+    assert_eq!(headers["location"], format!("/v1/jobs/{id}").as_str());
+    assert_eq!((job["state"].as_str(), job["attempts"].as_i64()), (Some("queued"), Some(0)));
+    let spec_back: Value = json_call(&t, "GET", &format!("/v1/jobs/{id}"), Body::empty()).await.1;
+    assert_eq!(spec_back["state"], "queued");
+
+    // Drain one step.
+    let (tx, rx) = tokio::sync::watch::channel(false);
+    assert_eq!(t.worker.run_once(&rx).await.unwrap(), Ran::Ran { job: id.clone(), outcome: "succeeded".into() });
+    assert_eq!(t.worker.run_once(&rx).await.unwrap(), Ran::Idle);
+    drop(tx);
+    let (_, done) = json_call(&t, "GET", &format!("/v1/jobs/{id}"), Body::empty()).await;
+    assert_eq!((done["state"].as_str(), done["progress"].as_f64()), (Some("succeeded"), Some(1.0)));
+    assert_eq!(done["result"]["source_to_target"]["flipped_faces"], 0);
+
+    // A finished job's SSE stream: one event, then the end.
+    let (st, h, ev) = call(&t, Request::get(format!("/v1/jobs/{id}/events")).body(Body::empty()).unwrap()).await;
+    assert_eq!((st, h["content-type"].to_str().unwrap()), (StatusCode::OK, "text/event-stream"));
+    let ev = String::from_utf8(ev).unwrap();
+    assert_eq!(ev.matches("event: job").count(), 1, "{ev}");
+    assert!(ev.contains("\"state\":\"succeeded\""));
+
+    // Artifacts: list, download with content types, compatible connectivity.
+    let (_, list) = json_call(&t, "GET", &format!("/v1/jobs/{id}/artifacts"), Body::empty()).await;
+    assert_eq!(list["artifacts"].as_array().unwrap().len(), 8);
+    let (st, h, obj) = call(&t, Request::get(format!("/v1/jobs/{id}/artifacts/source_on_target.obj")).body(Body::empty()).unwrap()).await;
+    assert_eq!((st, h["content-type"].to_str().unwrap()), (StatusCode::OK, "model/obj"));
+    let mapped = geom::io::read(&obj, &Default::default()).unwrap().mesh;
+    let source = geom::io::read(&s, &Default::default()).unwrap().mesh;
+    assert_eq!(mapped.faces(), source.faces());
+
+    // Metrics show the queue, the states and the worker's stage histogram.
+    let (_, _, m) = call(&t, Request::get("/metrics").body(Body::empty()).unwrap()).await;
+    let m = String::from_utf8(m).unwrap();
+    assert!(m.contains("surfmap_queue_depth 0"), "{m}");
+    assert!(m.contains("surfmap_jobs{state=\"succeeded\"} 1"), "{m}");
+    assert!(m.contains("surfmap_stage_duration_seconds_bucket{method=\"voronoi\",stage=\"layout\""), "{m}");
+}
+
+#[tokio::test]
+async fn validation_answers_before_queueing() {
+    let t = setup().await;
+    let (s, tg) = sphere_pair();
+    let (_, a) = json_call(&t, "POST", "/v1/meshes", Body::from(s)).await;
+    let (_, b) = json_call(&t, "POST", "/v1/meshes", Body::from(tg)).await;
+    let torus = geom::io::write(&geom::mesh::shapes::torus(12, 8, 1.0, 0.3), Format::Off);
+    let (_, c) = json_call(&t, "POST", "/v1/meshes", Body::from(torus)).await;
+    let submit = |target: &Value, spec: Value| {
+        let body = json!({"source": a["id"], "target": target, "spec": spec}).to_string();
+        json_call(&t, "POST", "/v1/jobs", Body::from(body))
+    };
+    let (st, e) = submit(&c["id"], spec()).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("topology_mismatch")));
+    let (st, e) = submit(&b["id"], json!({"method": "voronoi", "anchors": [[0, 0], [1, 1], [100000, 2]]})).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("invalid_anchors")));
+    let (st, e) = submit(&b["id"], json!({"method": "voronoi", "anchors": [[0, 0], [1, 1]]})).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("invalid_anchors")));
+    let (st, e) = submit(&b["id"], json!({"method": "quadz", "anchors": []})).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::BAD_REQUEST, Some("unknown_method")));
+    let (st, e) = json_call(&t, "POST", "/v1/jobs", Body::from("{not json")).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::BAD_REQUEST, Some("invalid_request")));
+    let (st, e) = json_call(&t, "POST", "/v1/meshes", Body::from(vec![b'x'; 2 << 20])).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::PAYLOAD_TOO_LARGE, Some("payload_too_large")));
+    let (st, e) = json_call(&t, "GET", "/v2/nothing", Body::empty()).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::NOT_FOUND, Some("route_not_found")));
+    let (st, e) = json_call(&t, "GET", "/v1/jobs?state=sleeping", Body::empty()).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::BAD_REQUEST, Some("invalid_query")));
+    let (_, page) = json_call(&t, "GET", "/v1/jobs", Body::empty()).await;
+    assert!(page["jobs"].as_array().unwrap().is_empty(), "nothing was queued");
+}
+
+#[tokio::test]
+async fn multipart_one_shot_and_paging() {
+    let t = setup().await;
+    let (s, tg) = sphere_pair();
+    let boundary = "XyZ";
+    let mut body = Vec::new();
+    for (name, file, bytes) in [("source", "a.off", s), ("target", "b.obj", tg), ("spec", "", spec().to_string().into_bytes())] {
+        body.extend(format!("--{boundary}\r\nContent-Disposition: form-data; name=\"{name}\"").bytes());
+        if !file.is_empty() {
+            body.extend(format!("; filename=\"{file}\"").bytes());
+        }
+        body.extend(b"\r\n\r\n");
+        body.extend(bytes);
+        body.extend(b"\r\n");
+    }
+    body.extend(format!("--{boundary}--\r\n").bytes());
+    for _ in 0..3 {
+        let req = Request::post("/v1/jobs")
+            .header("content-type", format!("multipart/form-data; boundary={boundary}"))
+            .body(Body::from(body.clone()))
+            .unwrap();
+        let (st, _, b) = call(&t, req).await;
+        assert_eq!(st, StatusCode::ACCEPTED, "{}", String::from_utf8_lossy(&b));
+    }
+    let (_, p1) = json_call(&t, "GET", "/v1/jobs?limit=2", Body::empty()).await;
+    assert_eq!(p1["jobs"].as_array().unwrap().len(), 2);
+    let cursor = p1["next_cursor"].as_str().unwrap();
+    let (_, p2) = json_call(&t, "GET", &format!("/v1/jobs?limit=2&cursor={cursor}"), Body::empty()).await;
+    assert_eq!(p2["jobs"].as_array().unwrap().len(), 1);
+    assert!(p2["next_cursor"].is_null());
+}
+
+#[tokio::test]
+async fn openapi_and_probes() {
+    let t = setup().await;
+    let (st, doc) = json_call(&t, "GET", "/openapi.json", Body::empty()).await;
+    assert_eq!(st, StatusCode::OK);
+    for path in ["/v1/meshes", "/v1/jobs", "/v1/jobs/{id}", "/v1/jobs/{id}/events", "/v1/jobs/{id}/artifacts/{name}"] {
+        assert!(doc["paths"][path].is_object(), "{path} missing from the OpenAPI document");
+    }
+    assert!(doc["components"]["schemas"]["JobView"].is_object());
+    assert_eq!(json_call(&t, "GET", "/healthz", Body::empty()).await.0, StatusCode::OK);
+    let (st, r) = json_call(&t, "GET", "/readyz", Body::empty()).await;
+    assert_eq!((st, r["store"].as_str()), (StatusCode::OK, Some("sqlite")));
+}

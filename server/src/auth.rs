@@ -36,7 +36,8 @@ impl Auth {
         if !self.enabled() {
             return Ok(String::new());
         }
-        let token = authorization.and_then(|h| h.strip_prefix("Bearer ")).map(str::trim).ok_or_else(ApiError::unauthorized)?;
+        let token =
+            authorization.and_then(|h| h.strip_prefix("Bearer ")).map(str::trim).ok_or_else(ApiError::unauthorized)?;
         let h = Sha256::digest(token.as_bytes());
         // Compare hashes, not tokens: no early exit on a prefix of a secret.
         self.owners.iter().find(|(k, _)| k[..] == h[..]).map(|(_, o)| o.clone()).ok_or_else(ApiError::unauthorized)

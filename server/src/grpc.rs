@@ -87,7 +87,10 @@ impl Surfmap for GrpcApi {
         let r = req.into_inner();
         let state = match r.state.as_str() {
             "" => None,
-            s => Some(JobState::parse(s).ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?),
+            s => Some(
+                JobState::parse(s)
+                    .ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?,
+            ),
         };
         let filter = JobFilter {
             state,
@@ -96,7 +99,10 @@ impl Surfmap for GrpcApi {
             limit: i64::from(r.limit),
         };
         let (jobs, next) = self.state.service.list(&o, filter).await?;
-        Ok(Response::new(pb::ListJobsResponse { jobs: jobs.iter().map(job).collect(), next_cursor: next.unwrap_or_default() }))
+        Ok(Response::new(pb::ListJobsResponse {
+            jobs: jobs.iter().map(job).collect(),
+            next_cursor: next.unwrap_or_default(),
+        }))
     }
 
     async fn cancel_job(&self, req: Request<pb::CancelJobRequest>) -> Result<Response<pb::Job>, Status> {
@@ -124,7 +130,10 @@ impl Surfmap for GrpcApi {
 
     type GetArtifactStream = BoxStream<pb::ArtifactChunk>;
 
-    async fn get_artifact(&self, req: Request<pb::GetArtifactRequest>) -> Result<Response<Self::GetArtifactStream>, Status> {
+    async fn get_artifact(
+        &self,
+        req: Request<pb::GetArtifactRequest>,
+    ) -> Result<Response<Self::GetArtifactStream>, Status> {
         let o = owner(&self.state, &req)?;
         let r = req.into_inner();
         let (a, bytes) = self.state.service.artifact(&o, &r.job_id, &r.name).await?;

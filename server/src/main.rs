@@ -88,7 +88,11 @@ async fn run(a: Args) -> anyhow::Result<()> {
     let (tx, rx) = tokio::sync::watch::channel(false);
     let lease = Duration::from_secs_f64(a.lease_secs);
     let mut tasks = Vec::new();
-    tasks.push(tokio::spawn(surfmap_server::janitor(store.clone(), (lease / 2).max(Duration::from_millis(200)), rx.clone())));
+    tasks.push(tokio::spawn(surfmap_server::janitor(
+        store.clone(),
+        (lease / 2).max(Duration::from_millis(200)),
+        rx.clone(),
+    )));
     let n = a.workers.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     for i in 0..n {
         let config = WorkerConfig {

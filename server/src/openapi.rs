@@ -6,9 +6,24 @@ use crate::views::{ArtifactList, ArtifactView, JobLinks, JobPage, JobView, MeshV
 
 #[derive(utoipa::OpenApi)]
 #[openapi(
-    info(title = "surfmap", description = "Compatible meshes, cross-parameterizations and distortion metrics for pairs of triangle meshes."),
-    paths(meshes::upload_mesh, jobs::submit_job, jobs::list_jobs, jobs::get_job, jobs::cancel_job, jobs::job_events,
-          artifacts::list_artifacts, artifacts::get_artifact, ops::healthz, ops::readyz, ops::metrics, ops::openapi),
+    info(
+        title = "surfmap",
+        description = "Compatible meshes, cross-parameterizations and distortion metrics for pairs of triangle meshes."
+    ),
+    paths(
+        meshes::upload_mesh,
+        jobs::submit_job,
+        jobs::list_jobs,
+        jobs::get_job,
+        jobs::cancel_job,
+        jobs::job_events,
+        artifacts::list_artifacts,
+        artifacts::get_artifact,
+        ops::healthz,
+        ops::readyz,
+        ops::metrics,
+        ops::openapi
+    ),
     components(schemas(ErrorBody, MeshView, JobView, JobLinks, JobPage, ArtifactView, ArtifactList, SubmitJob))
 )]
 pub struct ApiDoc;

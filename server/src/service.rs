@@ -53,7 +53,10 @@ fn parse_format(hint: Option<&str>) -> Result<Option<Format>, ApiError> {
         Some("ply") => Some(Format::Ply),
         Some("stl") => Some(Format::Stl),
         Some(other) => {
-            return Err(ApiError::bad_request("unknown_format", format!("format {other:?} is not obj, off, ply or stl")));
+            return Err(ApiError::bad_request(
+                "unknown_format",
+                format!("format {other:?} is not obj, off, ply or stl"),
+            ));
         }
     })
 }
@@ -115,7 +118,10 @@ impl JobService {
 
     async fn summary(&self, owner: &str, role: &str, id: &str) -> Result<geom::topology::Summary, ApiError> {
         let m = self.store.get_mesh(owner, id).await?.ok_or_else(|| {
-            ApiError::not_found("mesh_not_found", format!("{role} mesh {id:?} is not known; upload it with POST /v1/meshes"))
+            ApiError::not_found(
+                "mesh_not_found",
+                format!("{role} mesh {id:?} is not known; upload it with POST /v1/meshes"),
+            )
         })?;
         serde_json::from_str(&m.summary).map_err(ApiError::internal)
     }
@@ -160,7 +166,10 @@ impl JobService {
     /// # Errors
     /// 404 for a job `owner` cannot see.
     pub async fn get(&self, owner: &str, id: &str) -> Result<JobRecord, ApiError> {
-        self.store.get_job(owner, id).await?.ok_or_else(|| ApiError::not_found("job_not_found", format!("no job {id:?}")))
+        self.store
+            .get_job(owner, id)
+            .await?
+            .ok_or_else(|| ApiError::not_found("job_not_found", format!("no job {id:?}")))
     }
 
     /// A page of jobs and the cursor of the next one.
@@ -177,7 +186,10 @@ impl JobService {
     /// # Errors
     /// 404 for an unknown job.
     pub async fn cancel(&self, owner: &str, id: &str) -> Result<JobRecord, ApiError> {
-        self.store.cancel_job(owner, id).await?.ok_or_else(|| ApiError::not_found("job_not_found", format!("no job {id:?}")))
+        self.store
+            .cancel_job(owner, id)
+            .await?
+            .ok_or_else(|| ApiError::not_found("job_not_found", format!("no job {id:?}")))
     }
 
     /// One artifact's record and bytes. The name must be one the job lists: a name with a
@@ -187,15 +199,24 @@ impl JobService {
     /// 400 `invalid_artifact_name`; 404 unknown job or artifact.
     pub async fn artifact(&self, owner: &str, id: &str, name: &str) -> Result<(ArtifactRef, Vec<u8>), ApiError> {
         if name.is_empty() || name.contains(['/', '\\', '\0']) || name.contains("..") {
-            return Err(ApiError::bad_request("invalid_artifact_name", format!("artifact name {name:?} is not a plain file name")));
+            return Err(ApiError::bad_request(
+                "invalid_artifact_name",
+                format!("artifact name {name:?} is not a plain file name"),
+            ));
         }
         let job = self.get(owner, id).await?;
         let a = job.artifacts.iter().find(|a| a.name == name).cloned().ok_or_else(|| {
-            ApiError::not_found("artifact_not_found", format!("job {id} has no artifact {name:?} (state {})", job.state.as_str()))
+            ApiError::not_found(
+                "artifact_not_found",
+                format!("job {id} has no artifact {name:?} (state {})", job.state.as_str()),
+            )
         })?;
-        let bytes = self.blobs.get(&a.sha256).await.map_err(ApiError::internal)?.ok_or_else(|| {
-            ApiError::internal(format!("blob {} of job {id} is missing", a.sha256))
-        })?;
+        let bytes = self
+            .blobs
+            .get(&a.sha256)
+            .await
+            .map_err(ApiError::internal)?
+            .ok_or_else(|| ApiError::internal(format!("blob {} of job {id} is missing", a.sha256)))?;
         Ok((a, bytes))
     }
 
@@ -226,7 +247,8 @@ impl JobService {
                         }
                     }
                 };
-                let key = (job.state.as_str().to_string(), job.stage.clone(), (job.progress * 1000.0) as i64, job.attempts);
+                let key =
+                    (job.state.as_str().to_string(), job.stage.clone(), (job.progress * 1000.0) as i64, job.attempts);
                 if s.last.as_ref() != Some(&key) {
                     s.last = Some(key);
                     s.done = job.state.is_terminal();

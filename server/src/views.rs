@@ -121,7 +121,10 @@ pub fn job_view(j: &JobRecord) -> JobView {
         updated_at_ms: j.updated_at,
         started_at_ms: j.started_at,
         finished_at_ms: j.finished_at,
-        error: j.error_code.as_ref().map(|c| ErrorBody { code: c.clone(), message: j.error_message.clone().unwrap_or_default() }),
+        error: j
+            .error_code
+            .as_ref()
+            .map(|c| ErrorBody { code: c.clone(), message: j.error_message.clone().unwrap_or_default() }),
         result: j.result.as_deref().and_then(|r| serde_json::from_str(r).ok()),
         artifacts: j.artifacts.iter().map(|a| artifact_view(&j.id, a)).collect(),
         links: JobLinks {

@@ -24,7 +24,8 @@ async fn setup() -> T {
     let store = Store::connect(&format!("sqlite://{}", dir.path().join("t.db").display())).await.unwrap();
     let blobs = BlobStore::open(dir.path()).unwrap();
     let limits = Limits { max_body_bytes: 1 << 20, ..Limits::default() };
-    let state = AppState { service: JobService { store: store.clone(), blobs: blobs.clone(), limits }, auth: Auth::new(&[]) };
+    let state =
+        AppState { service: JobService { store: store.clone(), blobs: blobs.clone(), limits }, auth: Auth::new(&[]) };
     let worker = Worker { store, blobs, config: WorkerConfig::default() };
     T { _dir: dir, state, worker }
 }
@@ -90,7 +91,9 @@ async fn upload_submit_drain_and_download() {
     // Artifacts: list, download with content types, compatible connectivity.
     let (_, list) = json_call(&t, "GET", &format!("/v1/jobs/{id}/artifacts"), Body::empty()).await;
     assert_eq!(list["artifacts"].as_array().unwrap().len(), 8);
-    let (st, h, obj) = call(&t, Request::get(format!("/v1/jobs/{id}/artifacts/source_on_target.obj")).body(Body::empty()).unwrap()).await;
+    let (st, h, obj) =
+        call(&t, Request::get(format!("/v1/jobs/{id}/artifacts/source_on_target.obj")).body(Body::empty()).unwrap())
+            .await;
     assert_eq!((st, h["content-type"].to_str().unwrap()), (StatusCode::OK, "model/obj"));
     let mapped = geom::io::read(&obj, &Default::default()).unwrap().mesh;
     let source = geom::io::read(&s, &Default::default()).unwrap().mesh;
@@ -142,7 +145,9 @@ async fn multipart_one_shot_and_paging() {
     let (s, tg) = sphere_pair();
     let boundary = "XyZ";
     let mut body = Vec::new();
-    for (name, file, bytes) in [("source", "a.off", s), ("target", "b.obj", tg), ("spec", "", spec().to_string().into_bytes())] {
+    for (name, file, bytes) in
+        [("source", "a.off", s), ("target", "b.obj", tg), ("spec", "", spec().to_string().into_bytes())]
+    {
         body.extend(format!("--{boundary}\r\nContent-Disposition: form-data; name=\"{name}\"").bytes());
         if !file.is_empty() {
             body.extend(format!("; filename=\"{file}\"").bytes());

@@ -181,7 +181,8 @@ impl Store {
             .bind(&j.source).bind(&j.target).bind(j.max_attempts).bind(now)
             .execute(p).await?.rows_affected());
         if inserted == 1 {
-            let job = self.get_job_any(&id).await?.ok_or_else(|| StoreError::Corrupt("inserted job vanished".into()))?;
+            let job =
+                self.get_job_any(&id).await?.ok_or_else(|| StoreError::Corrupt("inserted job vanished".into()))?;
             return Ok((job, true));
         }
         let key = j.idempotency_key.as_deref().unwrap_or_default();
@@ -263,14 +264,18 @@ impl Store {
     pub async fn claim(&self, worker: &str, lease_ms: i64) -> Result<Option<Claim>> {
         let now = now_ms();
         let row = match &self.db {
-            Db::Sqlite(p) => match sqlx::query(CLAIM_SQLITE).bind(worker).bind(now + lease_ms).bind(now).fetch_optional(p).await? {
-                Some(r) => Some(job_from_row!(&r)),
-                None => None,
-            },
-            Db::Postgres(p) => match sqlx::query(CLAIM_POSTGRES).bind(worker).bind(now + lease_ms).bind(now).fetch_optional(p).await? {
-                Some(r) => Some(job_from_row!(&r)),
-                None => None,
-            },
+            Db::Sqlite(p) => {
+                match sqlx::query(CLAIM_SQLITE).bind(worker).bind(now + lease_ms).bind(now).fetch_optional(p).await? {
+                    Some(r) => Some(job_from_row!(&r)),
+                    None => None,
+                }
+            }
+            Db::Postgres(p) => {
+                match sqlx::query(CLAIM_POSTGRES).bind(worker).bind(now + lease_ms).bind(now).fetch_optional(p).await? {
+                    Some(r) => Some(job_from_row!(&r)),
+                    None => None,
+                }
+            }
         };
         Ok(row.map(|job| Claim { fence: job.fence, job }))
     }
@@ -279,7 +284,14 @@ impl Store {
     ///
     /// # Errors
     /// Database failures.
-    pub async fn heartbeat(&self, id: &str, fence: i64, stage: &str, progress: f64, lease_ms: i64) -> Result<Heartbeat> {
+    pub async fn heartbeat(
+        &self,
+        id: &str,
+        fence: i64,
+        stage: &str,
+        progress: f64,
+        lease_ms: i64,
+    ) -> Result<Heartbeat> {
         let now = now_ms();
         let cancel: Option<i64> = on!(self, p => {
             match sqlx::query("UPDATE jobs SET stage = $3, progress = $4, lease_expires_at = $5, updated_at = $6 \
@@ -310,7 +322,9 @@ impl Store {
                 Some(result.clone()),
                 Some(serde_json::to_string(artifacts).map_err(|e| StoreError::Corrupt(e.to_string()))?),
             ),
-            Outcome::Failed { code, message } => (JobState::Failed, Some(code.clone()), Some(message.clone()), None, None),
+            Outcome::Failed { code, message } => {
+                (JobState::Failed, Some(code.clone()), Some(message.clone()), None, None)
+            }
             Outcome::Cancelled => (JobState::Cancelled, None, None, None, None),
         };
         let progress = if state == JobState::Succeeded { 1.0 } else { -1.0 };
@@ -378,4 +392,3 @@ impl Store {
             .collect())
     }
 }
-

@@ -156,9 +156,10 @@ async fn cancellation_of_queued_and_running_jobs() {
         let running = store.cancel_job("alice", &q.id).await.unwrap().unwrap();
         assert_eq!(running.state, JobState::Running);
         assert!(running.cancel_requested);
-        assert_eq!(store.heartbeat(&q.id, c.fence, "layout", 0.1, 60_000).await.unwrap(), Heartbeat::Extended {
-            cancel: true
-        });
+        assert_eq!(
+            store.heartbeat(&q.id, c.fence, "layout", 0.1, 60_000).await.unwrap(),
+            Heartbeat::Extended { cancel: true }
+        );
         assert!(store.complete(&q.id, c.fence, &Outcome::Cancelled).await.unwrap());
         assert_eq!(store.get_job_any(&q.id).await.unwrap().unwrap().state, JobState::Cancelled);
     }
@@ -184,8 +185,9 @@ async fn listing_pages_and_filters() {
         }
         ids.reverse();
         assert_eq!(seen, ids, "newest first, every job once");
-        let running =
-            store.list_jobs("alice", &JobFilter { state: Some(JobState::Running), limit: 10, ..Default::default() }).await;
+        let running = store
+            .list_jobs("alice", &JobFilter { state: Some(JobState::Running), limit: 10, ..Default::default() })
+            .await;
         assert_eq!(running.unwrap().len(), 1);
         assert!(store.list_jobs("bob", &JobFilter { limit: 10, ..Default::default() }).await.unwrap().is_empty());
         let m = MeshRecord {

@@ -26,7 +26,11 @@ pub fn bin_dir() -> PathBuf {
 /// A binary of the workspace; panics with the fix when it has not been built.
 pub fn binary(name: &str) -> PathBuf {
     let p = bin_dir().join(name);
-    assert!(p.exists(), "{} is missing: run `cargo build --workspace --bins` (cargo test --workspace does)", p.display());
+    assert!(
+        p.exists(),
+        "{} is missing: run `cargo build --workspace --bins` (cargo test --workspace does)",
+        p.display()
+    );
     p
 }
 
@@ -139,9 +143,10 @@ impl Env {
         args.extend(extra.iter().map(|s| s.to_string()));
         let n = std::fs::read_dir(self.dir.path()).map(|d| d.count()).unwrap_or(0);
         let p = spawn("surfmap-server", &args, self.dir.path().join(format!("server-{n}.log")));
-        let addr = p.first_line.strip_prefix("listening on ").unwrap_or_else(|| {
-            panic!("server did not print its address: {:?}\n{}", p.first_line, p.log_text())
-        });
+        let addr = p
+            .first_line
+            .strip_prefix("listening on ")
+            .unwrap_or_else(|| panic!("server did not print its address: {:?}\n{}", p.first_line, p.log_text()));
         let base = format!("http://{addr}");
         (p, base)
     }
@@ -158,12 +163,18 @@ impl Env {
 }
 
 /// A registered pair with ground truth: the SMPL man and woman (same connectivity).
-pub const SMPL: (&str, &str) = ("meshes/registered/smpl_human/human_man.obj", "meshes/registered/smpl_human/human_woman.obj");
+pub const SMPL: (&str, &str) =
+    ("meshes/registered/smpl_human/human_man.obj", "meshes/registered/smpl_human/human_woman.obj");
 
 /// `k` farthest-point samples (Euclidean, from vertex 0) of a mesh file.
 pub fn fps_anchors(path: &Path, k: usize) -> Vec<u32> {
     let m = geom::io::read_path(path, &geom::io::ReadOptions::default()).expect("mesh").mesh;
-    let p: Vec<[f64; 3]> = (0..m.n_vertices()).map(|i| { let q = m.position(geom::VertexId(i as u32)); [q.x, q.y, q.z] }).collect();
+    let p: Vec<[f64; 3]> = (0..m.n_vertices())
+        .map(|i| {
+            let q = m.position(geom::VertexId(i as u32));
+            [q.x, q.y, q.z]
+        })
+        .collect();
     let d2 = |a: &[f64; 3], b: &[f64; 3]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2);
     let mut out = vec![0u32];
     let mut dist: Vec<f64> = p.iter().map(|q| d2(q, &p[0])).collect();

@@ -31,7 +31,8 @@ async fn oversize(api: &Api, length: Option<usize>, chunks: usize) -> (u16, Valu
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn every_class_of_bad_input_gets_a_clear_4xx() {
     let env = Env::sqlite();
-    let (_server, base) = env.server(&["--workers", "0", "--api-token", "alpha", "--api-token", "beta", "--max-body-mb", "1"]);
+    let (_server, base) =
+        env.server(&["--workers", "0", "--api-token", "alpha", "--api-token", "beta", "--max-body-mb", "1"]);
     let mut api = Api::new(&base);
 
     // Wrong or missing token.
@@ -60,7 +61,8 @@ async fn every_class_of_bad_input_gets_a_clear_4xx() {
     let (_, man) = api.upload(&shared(SMPL.0)).await;
     let (_, woman) = api.upload(&shared(SMPL.1)).await;
     let (_, torus) = api.upload(&shared("meshes/torus.obj")).await;
-    let (man, woman, torus) = (man["id"].as_str().unwrap(), woman["id"].as_str().unwrap(), torus["id"].as_str().unwrap());
+    let (man, woman, torus) =
+        (man["id"].as_str().unwrap(), woman["id"].as_str().unwrap(), torus["id"].as_str().unwrap());
 
     // Unknown method, malformed spec, anchors out of range, genus mismatch, unknown mesh.
     let magic = json!({"method": "magic", "anchors": [[0, 0], [1, 1], [2, 2]]});
@@ -124,11 +126,17 @@ async fn every_class_of_bad_input_gets_a_clear_4xx() {
         idempotency_key: String::new(),
     };
     let e = g.submit_job(req(&magic, woman)).await.unwrap_err();
-    assert_eq!((e.code(), e.metadata().get("surfmap-error-code").unwrap().to_str().unwrap()), (tonic::Code::InvalidArgument, "unknown_method"));
+    assert_eq!(
+        (e.code(), e.metadata().get("surfmap-error-code").unwrap().to_str().unwrap()),
+        (tonic::Code::InvalidArgument, "unknown_method")
+    );
     let e = g.submit_job(req(&spec, torus)).await.unwrap_err();
     assert_eq!(e.code(), tonic::Code::InvalidArgument);
     assert!(e.message().contains("genus"), "{}", e.message());
-    let e = g.upload_mesh(pb::UploadMeshRequest { data: b"OFF\n9 9 0\n".to_vec(), format_hint: String::new() }).await.unwrap_err();
+    let e = g
+        .upload_mesh(pb::UploadMeshRequest { data: b"OFF\n9 9 0\n".to_vec(), format_hint: String::new() })
+        .await
+        .unwrap_err();
     assert_eq!(e.code(), tonic::Code::InvalidArgument);
     let e = g.get_artifact(pb::GetArtifactRequest { job_id: id.into(), name: "../../x".into() }).await.unwrap_err();
     assert_eq!(e.code(), tonic::Code::InvalidArgument);

@@ -60,7 +60,8 @@ async fn rest_and_grpc(env: &Env) {
 
     // REST: submit, watch over SSE, download, judge with the shared evaluator.
     let spec = identity_spec("voronoi", 20);
-    let r = api.req(reqwest::Method::POST, "/v1/jobs").json(&json!({"source": src, "target": tgt, "spec": spec})).send();
+    let r =
+        api.req(reqwest::Method::POST, "/v1/jobs").json(&json!({"source": src, "target": tgt, "spec": spec})).send();
     let r = r.await.unwrap();
     assert_eq!(r.status(), 202);
     let location = r.headers()["location"].to_str().unwrap().to_string();
@@ -105,7 +106,12 @@ async fn rest_and_grpc(env: &Env) {
     let m = g.upload_mesh(pb::UploadMeshRequest { data, format_hint: String::new() }).await.unwrap().into_inner();
     assert_eq!(m.id, src, "content addressed");
     let spec2 = identity_spec("voronoi", 16);
-    let req = pb::SubmitJobRequest { source: src.clone(), target: tgt.clone(), spec_json: spec2.to_string(), idempotency_key: "g1".into() };
+    let req = pb::SubmitJobRequest {
+        source: src.clone(),
+        target: tgt.clone(),
+        spec_json: spec2.to_string(),
+        idempotency_key: "g1".into(),
+    };
     let j = g.submit_job(req.clone()).await.unwrap().into_inner();
     let again = g.submit_job(req).await.unwrap().into_inner();
     assert_eq!(j.id, again.id, "idempotent over gRPC");
@@ -120,7 +126,11 @@ async fn rest_and_grpc(env: &Env) {
     let arts = g.list_artifacts(pb::ListArtifactsRequest { job_id: j.id.clone() }).await.unwrap().into_inner();
     assert_eq!(arts.artifacts.len(), ARTIFACTS.len());
     let art = arts.artifacts.iter().find(|a| a.name == "target_on_source.obj").unwrap();
-    let mut chunks = g.get_artifact(pb::GetArtifactRequest { job_id: j.id.clone(), name: art.name.clone() }).await.unwrap().into_inner();
+    let mut chunks = g
+        .get_artifact(pb::GetArtifactRequest { job_id: j.id.clone(), name: art.name.clone() })
+        .await
+        .unwrap()
+        .into_inner();
     let (mut bytes, mut n) = (Vec::new(), 0);
     while let Some(c) = chunks.next().await {
         let c = c.unwrap();
@@ -193,7 +203,8 @@ async fn crash(env: &Env) {
         let (api, id) = (api.clone(), id.clone());
         async move {
             let j = api.job(&id).await;
-            (j["state"] == "running" && j["stage"] != "claimed").then(|| j["worker"].as_str().unwrap_or_default().to_string())
+            (j["state"] == "running" && j["stage"] != "claimed")
+                .then(|| j["worker"].as_str().unwrap_or_default().to_string())
         }
     })
     .await
@@ -238,7 +249,10 @@ async fn a_stalled_worker_s_late_write_is_rejected_by_the_fence() {
     a.signal("STOP");
     let _b = env.worker("b", &["--lease-secs", "2"]);
     let done = api.wait_done(&id, Duration::from_secs(120)).await;
-    assert_eq!((done["state"].as_str(), done["attempts"].as_i64(), done["worker"].as_str()), (Some("succeeded"), Some(2), Some("b")));
+    assert_eq!(
+        (done["state"].as_str(), done["attempts"].as_i64(), done["worker"].as_str()),
+        (Some("succeeded"), Some(2), Some("b"))
+    );
     a.signal("CONT");
     let rejected = wait_for(Duration::from_secs(60), || {
         let log = a.log_text();

@@ -1,9 +1,9 @@
 //! Running one claimed job: the heartbeat loop around the blocking pipeline call, and the
 //! mapping of its outcome onto the store (fenced completion, release on shutdown).
 
+use crate::Shutdown;
 use crate::config::WorkerConfig;
 use crate::progress::Shared;
-use crate::Shutdown;
 use geom::io::ReadOptions;
 use geom::mesh::MeshLimits;
 use geom::pipeline::JobSpec;
@@ -83,7 +83,8 @@ impl Worker {
         let shared = Shared::default();
         let mut progress = shared.clone();
         let (spec, source, target) = inputs;
-        let mut handle = tokio::task::spawn_blocking(move || geom::pipeline::run_map(&spec, &source, &target, &mut progress));
+        let mut handle =
+            tokio::task::spawn_blocking(move || geom::pipeline::run_map(&spec, &source, &target, &mut progress));
         let deadline = tokio::time::Instant::now() + self.config.time_limit;
         let mut grace_end: Option<tokio::time::Instant> = None;
         let mut stops = Stops::default();
@@ -130,7 +131,12 @@ impl Worker {
     }
 
     /// Spec and meshes of a job, read under the vertex cap.
-    async fn load(&self, spec: &str, source: &str, target: &str) -> Result<(JobSpec, geom::Mesh, geom::Mesh), geom::Error> {
+    async fn load(
+        &self,
+        spec: &str,
+        source: &str,
+        target: &str,
+    ) -> Result<(JobSpec, geom::Mesh, geom::Mesh), geom::Error> {
         let spec = JobSpec::from_json(spec.as_bytes())?;
         let limits = MeshLimits { max_vertices: self.config.max_vertices, max_faces: 2 * self.config.max_vertices + 8 };
         let read = move |bytes: Vec<u8>| geom::io::read(&bytes, &ReadOptions { limits, hint: None }).map(|r| r.mesh);
@@ -157,8 +163,14 @@ impl Worker {
     ) -> Result<(String, Vec<ArtifactRef>), geom::Error> {
         let mut refs = Vec::with_capacity(artifacts.len());
         for a in artifacts {
-            let sha256 = self.blobs.put(&a.bytes).await.map_err(|e| geom::Error::Internal(format!("artifact store: {e}")))?;
-            refs.push(ArtifactRef { name: a.name, content_type: a.content_type.to_string(), sha256, size: a.bytes.len() as u64 });
+            let sha256 =
+                self.blobs.put(&a.bytes).await.map_err(|e| geom::Error::Internal(format!("artifact store: {e}")))?;
+            refs.push(ArtifactRef {
+                name: a.name,
+                content_type: a.content_type.to_string(),
+                sha256,
+                size: a.bytes.len() as u64,
+            });
         }
         for (stage, ms) in &report.timings_ms {
             metrics::histogram!("surfmap_stage_duration_seconds", "method" => report.method, "stage" => stage.clone())

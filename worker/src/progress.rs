@@ -36,7 +36,8 @@ impl Shared {
 
 impl geom::progress::Progress for Shared {
     fn report(&mut self, stage: &str, fraction: f64) {
-        let overall = STAGES.iter().find(|s| s.0 == stage).map(|&(_, base, span)| base + span * fraction.clamp(0.0, 1.0));
+        let overall =
+            STAGES.iter().find(|s| s.0 == stage).map(|&(_, base, span)| base + span * fraction.clamp(0.0, 1.0));
         if let Ok(mut s) = self.state.lock() {
             s.0 = stage.to_string();
             if let Some(o) = overall {

@@ -52,7 +52,11 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
         }
     }
     let missing = |p: &str| ApiError::bad_request("invalid_multipart", format!("missing part {p:?}"));
-    Ok((source.ok_or_else(|| missing("source"))?, target.ok_or_else(|| missing("target"))?, spec.ok_or_else(|| missing("spec"))?))
+    Ok((
+        source.ok_or_else(|| missing("source"))?,
+        target.ok_or_else(|| missing("target"))?,
+        spec.ok_or_else(|| missing("spec"))?,
+    ))
 }
 
 /// Validates a job against its meshes and queues it.
@@ -66,7 +70,9 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
 pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Request) -> Result<Response, ApiError> {
     let key = req.headers().get("idempotency-key").and_then(|v| v.to_str().ok()).map(str::to_string);
     let (source, target, spec) = if is_multipart(req.headers()) {
-        let mp = Multipart::from_request(req, &st).await.map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;
+        let mp = Multipart::from_request(req, &st)
+            .await
+            .map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;
         multipart_job(&st, &owner, mp).await?
     } else {
         let (parts, body) = req.into_parts();
@@ -90,18 +96,33 @@ pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Re
 /// State, stage, progress, attempts, timestamps, error and result links of a job.
 #[utoipa::path(get, path = "/v1/jobs/{id}", tag = "jobs", params(("id" = String, Path)),
     responses((status = 200, body = JobView), (status = 404, body = ErrorBody)))]
-pub async fn get_job(State(st): State<AppState>, Owner(owner): Owner, P(id): P<String>) -> Result<Json<JobView>, ApiError> {
+pub async fn get_job(
+    State(st): State<AppState>,
+    Owner(owner): Owner,
+    P(id): P<String>,
+) -> Result<Json<JobView>, ApiError> {
     Ok(Json(job_view(&st.service.get(&owner, &id).await?)))
 }
 
 /// Jobs, newest first, with filters and cursor paging.
 #[utoipa::path(get, path = "/v1/jobs", tag = "jobs", params(ListQuery), responses((status = 200, body = JobPage)))]
-pub async fn list_jobs(State(st): State<AppState>, Owner(owner): Owner, Q(q): Q<ListQuery>) -> Result<Json<JobPage>, ApiError> {
+pub async fn list_jobs(
+    State(st): State<AppState>,
+    Owner(owner): Owner,
+    Q(q): Q<ListQuery>,
+) -> Result<Json<JobPage>, ApiError> {
     let state = match q.state.as_deref() {
         None | Some("") => None,
-        Some(s) => Some(JobState::parse(s).ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?),
+        Some(s) => Some(
+            JobState::parse(s).ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?,
+        ),
     };
-    let filter = JobFilter { state, method: q.method.filter(|m| !m.is_empty()), before: q.cursor.filter(|c| !c.is_empty()), limit: q.limit.unwrap_or(50) };
+    let filter = JobFilter {
+        state,
+        method: q.method.filter(|m| !m.is_empty()),
+        before: q.cursor.filter(|c| !c.is_empty()),
+        limit: q.limit.unwrap_or(50),
+    };
     let (jobs, next_cursor) = st.service.list(&owner, filter).await?;
     Ok(Json(JobPage { jobs: jobs.iter().map(job_view).collect(), next_cursor }))
 }
@@ -109,7 +130,11 @@ pub async fn list_jobs(State(st): State<AppState>, Owner(owner): Owner, Q(q): Q<
 /// Cancels a queued job at once; a running job stops at its next check.
 #[utoipa::path(post, path = "/v1/jobs/{id}/cancel", tag = "jobs", params(("id" = String, Path)),
     responses((status = 200, body = JobView), (status = 404, body = ErrorBody)))]
-pub async fn cancel_job(State(st): State<AppState>, Owner(owner): Owner, P(id): P<String>) -> Result<Json<JobView>, ApiError> {
+pub async fn cancel_job(
+    State(st): State<AppState>,
+    Owner(owner): Owner,
+    P(id): P<String>,
+) -> Result<Json<JobView>, ApiError> {
     Ok(Json(job_view(&st.service.cancel(&owner, &id).await?)))
 }
 

@@ -39,7 +39,9 @@ pub async fn upload_mesh(
     req: Request,
 ) -> Result<(StatusCode, Json<MeshView>), ApiError> {
     let (bytes, ext) = if is_multipart(req.headers()) {
-        let mp = Multipart::from_request(req, &st).await.map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;
+        let mp = Multipart::from_request(req, &st)
+            .await
+            .map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;
         first_file(mp).await?
     } else {
         let (parts, body) = req.into_parts();

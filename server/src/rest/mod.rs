@@ -57,9 +57,13 @@ impl<T: serde::de::DeserializeOwned + Send, S: Send + Sync> FromRequestParts<S> 
 /// # Errors
 /// 413 `payload_too_large`.
 pub async fn read_limited(headers: &HeaderMap, body: Body, limit: usize) -> Result<Bytes, ApiError> {
-    let declared = headers.get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.parse::<u64>().ok());
+    let declared =
+        headers.get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.parse::<u64>().ok());
     if declared.is_some_and(|n| n > limit as u64) {
-        return Err(ApiError::too_large(format!("request body of {} bytes exceeds the limit of {limit}", declared.unwrap_or(0))));
+        return Err(ApiError::too_large(format!(
+            "request body of {} bytes exceeds the limit of {limit}",
+            declared.unwrap_or(0)
+        )));
     }
     axum::body::to_bytes(body, limit)
         .await
@@ -68,7 +72,10 @@ pub async fn read_limited(headers: &HeaderMap, body: Body, limit: usize) -> Resu
 
 /// True for a `multipart/form-data` request.
 pub fn is_multipart(headers: &HeaderMap) -> bool {
-    headers.get(header::CONTENT_TYPE).and_then(|v| v.to_str().ok()).is_some_and(|v| v.starts_with("multipart/form-data"))
+    headers
+        .get(header::CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+        .is_some_and(|v| v.starts_with("multipart/form-data"))
 }
 
 /// Multipart errors as JSON (413 when over the body limit).

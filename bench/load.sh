@@ -14,10 +14,10 @@ DB="sqlite://$WORK/surfmap.db"
 SERVER=$!
 for _ in $(seq 100); do grep -q listening "$WORK/server.out" 2>/dev/null && break; sleep 0.1; done
 ADDR="$(sed -n 's/^listening on //p' "$WORK/server.out")"
-# Workers run at a lower CPU priority than the API (as batch work should).
-nice -n "${WORKER_NICE:-10}" "$BIN/surfmap-worker" --database-url "$DB" --data-dir "$WORK/data" --worker-id wa > /dev/null 2> "$WORK/wa.log" &
+# WORKER_NICE=10 runs the workers below the API's CPU priority (the figures in the issue note are at 0).
+nice -n "${WORKER_NICE:-0}" "$BIN/surfmap-worker" --database-url "$DB" --data-dir "$WORK/data" --worker-id wa > /dev/null 2> "$WORK/wa.log" &
 WA=$!
-nice -n "${WORKER_NICE:-10}" "$BIN/surfmap-worker" --database-url "$DB" --data-dir "$WORK/data" --worker-id wb > /dev/null 2> "$WORK/wb.log" &
+nice -n "${WORKER_NICE:-0}" "$BIN/surfmap-worker" --database-url "$DB" --data-dir "$WORK/data" --worker-id wb > /dev/null 2> "$WORK/wb.log" &
 WB=$!
 M=../shared/meshes/registered/smpl_human
 "$BIN/surfmap-load" --base "http://$ADDR" --source $M/human_man.obj --target $M/human_woman.obj \

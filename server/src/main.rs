@@ -49,19 +49,7 @@ struct Args {
 
 #[tokio::main]
 async fn main() -> std::process::ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info,sqlx=warn".into()),
-        )
-        .with_writer(std::io::stderr)
-        .init();
-    match run(Args::parse()).await {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("surfmap-server: {e:#}");
-            std::process::ExitCode::from(1)
-        }
-    }
+    surfmap_worker::process_main("surfmap-server", run(Args::parse())).await
 }
 
 async fn run(a: Args) -> anyhow::Result<()> {

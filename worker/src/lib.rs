@@ -24,3 +24,24 @@ pub async fn shutdown_signal() {
         _ = term.recv() => {}
     }
 }
+
+/// The body of both binaries' `main`: stderr logging (`RUST_LOG`, default `info`), then `run`;
+/// an error is printed with its causes and exits 1.
+pub async fn process_main(
+    name: &str,
+    run: impl std::future::Future<Output = anyhow::Result<()>>,
+) -> std::process::ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info,sqlx=warn".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    match run.await {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{name}: {e:#}");
+            std::process::ExitCode::from(1)
+        }
+    }
+}

@@ -117,3 +117,25 @@ async fn malformed_spec_in_the_store_fails_cleanly() {
     let j = s.worker.store.get_job_any(&id).await.unwrap().unwrap();
     assert_eq!(j.error_code.as_deref(), Some("invalid_spec"));
 }
+
+#[tokio::test]
+async fn shutdown_past_the_grace_period_releases_the_lease() {
+    let config =
+        WorkerConfig { lease: Duration::from_millis(150), shutdown_grace: Duration::ZERO, ..WorkerConfig::default() };
+    let mut s = setup(config).await;
+    // A larger sphere, so the job is still running when the grace period (zero) ends.
+    let big = shapes::icosphere(5);
+    s.source = s.worker.blobs.put(&geom::io::write(&big, Format::Off)).await.unwrap();
+    s.target = s.source.clone();
+    let id = submit(&s, spec()).await;
+    let (tx, rx) = tokio::sync::watch::channel(false);
+    tx.send(true).unwrap();
+    let ran = s.worker.run_once(&rx).await.unwrap();
+    assert_eq!(ran, Ran::Ran { job: id.clone(), outcome: "released".into() });
+    let j = s.worker.store.get_job_any(&id).await.unwrap().unwrap();
+    assert_eq!(
+        (j.state, j.attempts, j.stage.as_str()),
+        (JobState::Queued, 0, "released"),
+        "back in the queue, attempt not counted"
+    );
+}

@@ -99,9 +99,25 @@ async fn rest_and_grpc(env: &Env) {
     // gRPC on the same port: upload, submit, WatchJob, artifacts in chunks, health.
     let mut g = SurfmapClient::connect(base.clone()).await.unwrap();
     let channel = tonic::transport::Channel::from_shared(base.clone()).unwrap().connect().await.unwrap();
-    let mut health = tonic_health::pb::health_client::HealthClient::new(channel);
+    let mut health = tonic_health::pb::health_client::HealthClient::new(channel.clone());
     let h = health.check(tonic_health::pb::HealthCheckRequest { service: "surfmap.v1.Surfmap".into() }).await.unwrap();
     assert_eq!(h.into_inner().status, tonic_health::pb::health_check_response::ServingStatus::Serving as i32);
+    {
+        use tonic_reflection::pb::v1::server_reflection_request::MessageRequest;
+        use tonic_reflection::pb::v1::server_reflection_response::MessageResponse;
+        let mut refl = tonic_reflection::pb::v1::server_reflection_client::ServerReflectionClient::new(channel);
+        let ask = tonic_reflection::pb::v1::ServerReflectionRequest {
+            host: String::new(),
+            message_request: Some(MessageRequest::ListServices(String::new())),
+        };
+        let mut answers = refl.server_reflection_info(futures::stream::iter([ask])).await.unwrap().into_inner();
+        match answers.next().await.unwrap().unwrap().message_response {
+            Some(MessageResponse::ListServicesResponse(l)) => {
+                assert!(l.service.iter().any(|s| s.name == "surfmap.v1.Surfmap"), "{l:?}");
+            }
+            other => panic!("reflection answered {other:?}"),
+        }
+    }
     let data = std::fs::read(shared(SMPL.0)).unwrap();
     let m = g.upload_mesh(pb::UploadMeshRequest { data, format_hint: String::new() }).await.unwrap().into_inner();
     assert_eq!(m.id, src, "content addressed");

@@ -8,7 +8,6 @@ pub mod grpc;
 pub mod openapi;
 pub mod rest;
 pub mod service;
-pub mod telemetry;
 pub mod views;
 
 use std::time::Duration;
@@ -23,7 +22,7 @@ pub struct AppState {
 
 /// REST and gRPC (with health and reflection) on one router.
 pub fn app(state: AppState) -> axum::Router {
-    telemetry::prometheus();
+    surfmap_worker::telemetry::prometheus();
     let limit = state.service.limits.max_body_bytes;
     let grpc = SurfmapServer::new(grpc::GrpcApi { state: state.clone() })
         .max_decoding_message_size(limit)

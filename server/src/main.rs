@@ -56,7 +56,7 @@ async fn run(a: Args) -> anyhow::Result<()> {
     if !(a.lease_secs.is_finite() && a.lease_secs > 0.0) || a.max_attempts < 1 {
         anyhow::bail!("--lease-secs must be positive and --max-attempts at least 1");
     }
-    surfmap_server::telemetry::prometheus();
+    surfmap_worker::telemetry::prometheus();
     let store = surfmap_store::Store::connect(&a.database_url).await?;
     let blobs = surfmap_store::BlobStore::open(&a.data_dir)?;
     let limits = Limits {

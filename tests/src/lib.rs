@@ -162,6 +162,11 @@ impl Env {
     }
 }
 
+/// A port that was free a moment ago (for listeners that do not report the port they got).
+pub fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0").and_then(|l| l.local_addr()).map(|a| a.port()).expect("free port")
+}
+
 /// A registered pair with ground truth: the SMPL man and woman (same connectivity).
 pub const SMPL: (&str, &str) =
     ("meshes/registered/smpl_human/human_man.obj", "meshes/registered/smpl_human/human_woman.obj");

@@ -210,8 +210,10 @@ async fn crash(env: &Env) {
     let (_server, base) = env.server(&["--workers", "0", "--lease-secs", "2"]);
     let api = Api::new(&base);
     let (src, tgt) = upload_pair(&api).await;
-    let a = env.worker("a", &["--lease-secs", "2"]);
-    let b = env.worker("b", &["--lease-secs", "2"]);
+    let ports = [surfmap_e2e::free_port(), surfmap_e2e::free_port()];
+    let listen = ports.map(|p| format!("127.0.0.1:{p}"));
+    let a = env.worker("a", &["--lease-secs", "2", "--metrics-listen", &listen[0]]);
+    let b = env.worker("b", &["--lease-secs", "2", "--metrics-listen", &listen[1]]);
     let (st, job) = api.submit(&src, &tgt, &identity_spec("voronoi", 20)).await;
     assert_eq!(st, 202);
     let id = job["id"].as_str().unwrap().to_string();
@@ -235,6 +237,11 @@ async fn crash(env: &Env) {
     assert_eq!(done["artifacts"].as_array().unwrap().len(), ARTIFACTS.len());
     let (_, page) = api.get("/v1/jobs").await;
     assert_eq!(page["jobs"].as_array().unwrap().len(), 1, "exactly one job, one result");
+    // The survivor's own metrics endpoint has the stage and job durations of the job it ran.
+    let port = if owner == "a" { &listen[1] } else { &listen[0] };
+    let text = reqwest::get(format!("http://{port}/metrics")).await.unwrap().text().await.unwrap();
+    assert!(text.contains("surfmap_stage_duration_seconds_bucket{method=\"voronoi\",stage=\"metrics\""), "{text}");
+    assert!(text.contains("surfmap_job_duration_seconds_count{method=\"voronoi\",outcome=\"succeeded\"} 1"), "{text}");
     survivor.signal("TERM");
     assert!(survivor.wait_exit(Duration::from_secs(30)).is_some_and(|s| s.success()));
 }

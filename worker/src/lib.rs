@@ -5,6 +5,7 @@
 mod config;
 mod execute;
 mod progress;
+pub mod telemetry;
 
 pub use config::WorkerConfig;
 pub use execute::{Ran, Worker};

@@ -33,6 +33,10 @@ struct Args {
     /// On SIGTERM, how long the current job may finish before its lease is released.
     #[arg(long, env = "SURFMAP_SHUTDOWN_GRACE_SECS", default_value_t = 60)]
     shutdown_grace_secs: u64,
+    /// Serve this worker's Prometheus metrics (stage and job durations, failures by code) at
+    /// `http://ADDR/metrics`.
+    #[arg(long, env = "SURFMAP_METRICS_LISTEN")]
+    metrics_listen: Option<String>,
 }
 
 #[tokio::main]
@@ -54,8 +58,19 @@ async fn run(a: Args) -> anyhow::Result<()> {
         max_vertices: a.max_vertices,
         shutdown_grace: Duration::from_secs(a.shutdown_grace_secs),
     };
-    println!("worker {} ready", config.id);
+    surfmap_worker::telemetry::prometheus();
     let (tx, rx) = tokio::sync::watch::channel(false);
+    if let Some(addr) = &a.metrics_listen {
+        let listener = tokio::net::TcpListener::bind(addr).await?;
+        tracing::info!(addr = %listener.local_addr()?, "metrics at /metrics");
+        let rx = rx.clone();
+        tokio::spawn(async move {
+            if let Err(e) = surfmap_worker::telemetry::serve_metrics(listener, rx).await {
+                tracing::warn!("metrics listener: {e}");
+            }
+        });
+    }
+    println!("worker {} ready", config.id);
     tokio::spawn(async move {
         surfmap_worker::shutdown_signal().await;
         let _ = tx.send(true);

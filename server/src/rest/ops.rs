@@ -31,7 +31,7 @@ pub async fn metrics(State(st): State<AppState>) -> Result<impl IntoResponse, Ap
             metrics::gauge!("surfmap_queue_depth").set(n as f64);
         }
     }
-    Ok(([(header::CONTENT_TYPE, "text/plain; version=0.0.4")], crate::telemetry::prometheus().render()))
+    Ok(([(header::CONTENT_TYPE, "text/plain; version=0.0.4")], surfmap_worker::telemetry::prometheus().render()))
 }
 
 /// The OpenAPI 3.1 document of this API.

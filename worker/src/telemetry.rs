@@ -1,5 +1,6 @@
-//! The process-wide Prometheus recorder. Installed once, before any worker records, so the
-//! server's `/metrics` also shows what its in-process workers measured.
+//! The process-wide Prometheus recorder, installed once before anything records: the server's
+//! `/metrics` shows what its in-process workers measured, and a `surfmap-worker` process serves
+//! its own with `--metrics-listen`.
 
 use metrics_exporter_prometheus::{PrometheusBuilder, PrometheusHandle};
 use std::sync::OnceLock;
@@ -18,4 +19,19 @@ pub fn prometheus() -> &'static PrometheusHandle {
         }
         handle
     })
+}
+
+/// Serves `GET /metrics` (Prometheus text) on `listener` until `shutdown`.
+pub async fn serve_metrics(listener: tokio::net::TcpListener, mut shutdown: crate::Shutdown) -> std::io::Result<()> {
+    let app = axum::Router::new().route(
+        "/metrics",
+        axum::routing::get(|| async {
+            ([(axum::http::header::CONTENT_TYPE, "text/plain; version=0.0.4")], prometheus().render())
+        }),
+    );
+    axum::serve(listener, app)
+        .with_graceful_shutdown(async move {
+            let _ = shutdown.wait_for(|s| *s).await;
+        })
+        .await
 }

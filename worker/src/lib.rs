@@ -37,6 +37,7 @@ pub async fn process_main(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info,sqlx=warn".into()),
         )
         .with_writer(std::io::stderr)
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .init();
     match run.await {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -18,6 +18,8 @@ pub struct SurfaceIndex<'m> {
     mesh: &'m Mesh,
     tree: ImmutableKdTree<f64, 3>,
     k: NonZeroUsize,
+    /// Per face, an upper bound on the distance from its centroid to its points.
+    radius: Vec<f64>,
 }
 
 /// One query's answer.
@@ -88,23 +90,36 @@ impl<'m> SurfaceIndex<'m> {
     /// # Errors
     /// `Error::Internal` if the tree cannot be built (no faces).
     pub fn new(mesh: &'m Mesh) -> Result<Self> {
+        let mut radius = Vec::with_capacity(mesh.n_faces());
         let cents: Vec<[f64; 3]> = (0..mesh.n_faces())
             .map(|f| {
-                let c = centroid(mesh.face_points(FaceId::from_idx(f)));
+                let p = mesh.face_points(FaceId::from_idx(f));
+                let c = centroid(p);
+                let r = p.iter().map(|q| (q - c).norm()).fold(0.0, f64::max);
+                // Inflated against rounding, so the pruning bound stays a true lower bound.
+                radius.push(r * (1.0 + 1e-9) + 1e-300);
                 [c.x, c.y, c.z]
             })
             .collect();
         let tree = ImmutableKdTree::new_from_slice(&cents).map_err(|e| Error::Internal(format!("k-d tree: {e:?}")))?;
         let k = NonZeroUsize::new(CANDIDATES.min(mesh.n_faces()))
             .ok_or_else(|| Error::Internal("mesh has no faces".into()))?;
-        Ok(Self { mesh, tree, k })
+        Ok(Self { mesh, tree, k, radius })
     }
 
     /// Nearest point among the candidate faces.
+    ///
+    /// A candidate whose centroid distance minus its radius exceeds the best distance so far
+    /// cannot be strictly closer, so its closest-point test is skipped: the answer (distance,
+    /// face and point, ties included) is the same as testing every candidate.
     pub fn query(&self, p: &P3) -> Nearest {
         let cand = self.tree.query(&[p.x, p.y, p.z]).nearest_n::<SquaredEuclidean<f64>>(self.k).execute();
         let mut best = Nearest { distance: f64::INFINITY, face: FaceId(0), point: *p };
         for n in cand {
+            let lower = n.distance.sqrt() * (1.0 - 1e-9) - self.radius[n.item as usize];
+            if lower > best.distance {
+                continue;
+            }
             let f = FaceId(n.item);
             let [a, b, c] = self.mesh.face_points(f);
             let q = closest_point_on_triangle(*p, a, b, c);

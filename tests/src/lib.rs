@@ -8,9 +8,12 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// `../shared` from the workspace root.
+/// `../shared` beside the clone (or `$SURFMAP_SHARED`), as the geometry tests find it.
 pub fn shared(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared").join(rel)
+    let root = std::env::var_os("SURFMAP_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared"));
+    root.join(rel)
 }
 
 /// The directory holding the workspace's binaries (`target/<profile>`).

@@ -51,8 +51,9 @@ pub fn hausdorff(a: &Mesh, b: &Mesh, n: usize, seeds: (u64, u64)) -> Result<Haus
         // keep each result at its sample's index so the sum is the evaluator's, bit for bit.
         let mut mx: f64 = 0.0;
         let mut sq = vec![0.0; pts.len()];
+        let mut hint = None;
         for i in morton_order(&pts) {
-            let d = idx.query(&pts[i]).distance;
+            let d = idx.distance_near(&pts[i], &mut hint);
             mx = mx.max(d);
             sq[i] = d * d;
         }

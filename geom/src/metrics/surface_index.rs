@@ -107,6 +107,25 @@ impl<'m> SurfaceIndex<'m> {
         Ok(Self { mesh, tree, k, radius })
     }
 
+    /// The distance of [`SurfaceIndex::query`], for a stream of nearby queries: `hint` carries
+    /// the previous query point and its k-th candidate distance, and the triangle inequality
+    /// turns them into a radius that holds at least k centroids, which bounds this search.
+    /// The candidate set, and so the distance, is the same as without the hint.
+    pub fn distance_near(&self, p: &P3, hint: &mut Option<(P3, f64)>) -> f64 {
+        let q = [p.x, p.y, p.z];
+        let bounded = hint.and_then(|(prev, dk)| {
+            let r = (dk + (p - prev).norm()) * (1.0 + 1e-9);
+            let c = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).within(r * r).execute();
+            // Always k by the triangle inequality; the fallback only guards degenerate input.
+            (c.len() == self.k.get()).then_some(c)
+        });
+        let cand = bounded.unwrap_or_else(|| self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).execute());
+        if let Some(last) = cand.last() {
+            *hint = Some((*p, last.distance.sqrt()));
+        }
+        self.best_of(p, cand.iter().map(|n| (n.item, n.distance))).distance
+    }
+
     /// Nearest point among the candidate faces.
     ///
     /// A candidate whose centroid distance minus its radius exceeds the best distance so far
@@ -114,13 +133,18 @@ impl<'m> SurfaceIndex<'m> {
     /// face and point, ties included) is the same as testing every candidate.
     pub fn query(&self, p: &P3) -> Nearest {
         let cand = self.tree.query(&[p.x, p.y, p.z]).nearest_n::<SquaredEuclidean<f64>>(self.k).execute();
+        self.best_of(p, cand.iter().map(|n| (n.item, n.distance)))
+    }
+
+    /// The first strictly closest of the candidates `(face, squared centroid distance)`.
+    fn best_of(&self, p: &P3, cand: impl Iterator<Item = (u32, f64)>) -> Nearest {
         let mut best = Nearest { distance: f64::INFINITY, face: FaceId(0), point: *p };
-        for n in cand {
-            let lower = n.distance.sqrt() * (1.0 - 1e-9) - self.radius[n.item as usize];
+        for (item, d2) in cand {
+            let lower = d2.sqrt() * (1.0 - 1e-9) - self.radius[item as usize];
             if lower > best.distance {
                 continue;
             }
-            let f = FaceId(n.item);
+            let f = FaceId(item);
             let [a, b, c] = self.mesh.face_points(f);
             let q = closest_point_on_triangle(*p, a, b, c);
             let d = (q - p).norm();
@@ -145,6 +169,20 @@ mod tests {
         assert_eq!(closest_point_on_triangle(P3::new(2., -1., 0.), a, b, c), b);
         let q = closest_point_on_triangle(P3::new(1., 1., 0.), a, b, c);
         assert!((q - P3::new(0.5, 0.5, 0.)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn hinted_distances_equal_plain_queries() {
+        let s = shapes::icosphere(3);
+        let idx = SurfaceIndex::new(&s).unwrap();
+        let mut hint = None;
+        // A wandering walk of nearby and far queries, inside and outside the sphere.
+        for i in 0..2000 {
+            let t = f64::from(i) * 0.37;
+            let r = 0.5 + 0.9 * (t * 0.13).sin().abs();
+            let p = P3::new(r * t.cos() * (t * 0.7).sin(), r * t.sin() * (t * 0.7).sin(), r * (t * 0.7).cos());
+            assert_eq!(idx.distance_near(&p, &mut hint), idx.query(&p).distance, "query {i}");
+        }
     }
 
     #[test]

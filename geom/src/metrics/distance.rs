@@ -50,12 +50,10 @@ pub fn hausdorff(a: &Mesh, b: &Mesh, n: usize, seeds: (u64, u64)) -> Result<Haus
         // Query in Morton order (neighbouring queries touch the same tree nodes and faces), but
         // keep each result at its sample's index so the sum is the evaluator's, bit for bit.
         let mut mx: f64 = 0.0;
-        let mut sq = vec![0.0; pts.len()];
-        let mut hint = None;
-        for i in morton_order(&pts) {
-            let d = idx.distance_near(&pts[i], &mut hint);
+        let d = idx.distances_in_order(&pts, &morton_order(&pts));
+        let sq: Vec<f64> = d.iter().map(|d| d * d).collect();
+        for &d in &d {
             mx = mx.max(d);
-            sq[i] = d * d;
         }
         (mx, pairwise_sum(&sq) / pts.len() as f64)
     };

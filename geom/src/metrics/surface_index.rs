@@ -107,23 +107,42 @@ impl<'m> SurfaceIndex<'m> {
         Ok(Self { mesh, tree, k, radius })
     }
 
-    /// The distance of [`SurfaceIndex::query`], for a stream of nearby queries: `hint` carries
-    /// the previous query point and its k-th candidate distance, and the triangle inequality
-    /// turns them into a radius that holds at least k centroids, which bounds this search.
-    /// The candidate set, and so the distance, is the same as without the hint.
-    pub fn distance_near(&self, p: &P3, hint: &mut Option<(P3, f64)>) -> f64 {
-        let q = [p.x, p.y, p.z];
-        let bounded = hint.and_then(|(prev, dk)| {
-            let r = (dk + (p - prev).norm()) * (1.0 + 1e-9);
-            let c = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).within(r * r).execute();
-            // Always k by the triangle inequality; the fallback only guards degenerate input.
-            (c.len() == self.k.get()).then_some(c)
-        });
-        let cand = bounded.unwrap_or_else(|| self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).execute());
-        if let Some(last) = cand.last() {
-            *hint = Some((*p, last.distance.sqrt()));
+    /// The distances of [`SurfaceIndex::query`] for `pts`, visited in `order` (nearby points in
+    /// turn, e.g. Morton order). Each search is bounded by the previous point's k-th candidate
+    /// distance plus the step between the points: by the triangle inequality at least k
+    /// centroids lie inside, so the candidate set, and so the distance, is the same as an
+    /// unbounded search. One scratch buffer serves every search.
+    pub fn distances_in_order(&self, pts: &[P3], order: &[usize]) -> Vec<f64> {
+        let mut out = vec![0.0; pts.len()];
+        let mut scratch = self.tree.create_scratch::<SquaredEuclidean<f64>>();
+        let mut hint: Option<(P3, f64)> = None;
+        for &i in order {
+            let p = &pts[i];
+            let q = [p.x, p.y, p.z];
+            let bounded = hint.and_then(|(prev, dk)| {
+                let r = (dk + (p - prev).norm()) * (1.0 + 1e-9);
+                let c = self
+                    .tree
+                    .query(&q)
+                    .nearest_n::<SquaredEuclidean<f64>>(self.k)
+                    .within(r * r)
+                    .with_scratch(&mut scratch)
+                    .execute();
+                // Always k by the triangle inequality; the fallback only guards degenerate input.
+                (c.len() == self.k.get()).then_some(c)
+            });
+            let cand = match bounded {
+                Some(c) => c,
+                None => {
+                    self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).with_scratch(&mut scratch).execute()
+                }
+            };
+            if let Some(last) = cand.last() {
+                hint = Some((*p, last.distance.sqrt()));
+            }
+            out[i] = self.best_of(p, cand.iter().map(|n| (n.item, n.distance))).distance;
         }
-        self.best_of(p, cand.iter().map(|n| (n.item, n.distance))).distance
+        out
     }
 
     /// Nearest point among the candidate faces.
@@ -175,13 +194,18 @@ mod tests {
     fn hinted_distances_equal_plain_queries() {
         let s = shapes::icosphere(3);
         let idx = SurfaceIndex::new(&s).unwrap();
-        let mut hint = None;
         // A wandering walk of nearby and far queries, inside and outside the sphere.
-        for i in 0..2000 {
-            let t = f64::from(i) * 0.37;
-            let r = 0.5 + 0.9 * (t * 0.13).sin().abs();
-            let p = P3::new(r * t.cos() * (t * 0.7).sin(), r * t.sin() * (t * 0.7).sin(), r * (t * 0.7).cos());
-            assert_eq!(idx.distance_near(&p, &mut hint), idx.query(&p).distance, "query {i}");
+        let pts: Vec<P3> = (0..2000)
+            .map(|i| {
+                let t = f64::from(i) * 0.37;
+                let r = 0.5 + 0.9 * (t * 0.13).sin().abs();
+                P3::new(r * t.cos() * (t * 0.7).sin(), r * t.sin() * (t * 0.7).sin(), r * (t * 0.7).cos())
+            })
+            .collect();
+        let order: Vec<usize> = (0..pts.len()).rev().collect();
+        let d = idx.distances_in_order(&pts, &order);
+        for (i, p) in pts.iter().enumerate() {
+            assert_eq!(d[i], idx.query(p).distance, "query {i}");
         }
     }
 

@@ -2,13 +2,12 @@
 //! from the same `ApiError`s, `WatchJob` as a server stream and artifacts in 64 KiB chunks.
 
 use crate::AppState;
-use crate::error::ApiError;
-use crate::service::parse_spec;
+use crate::service::{job_filter, parse_spec};
 use futures::{Stream, StreamExt};
 use std::pin::Pin;
 use surfmap_proto::v1 as pb;
 use surfmap_proto::v1::surfmap_server::Surfmap;
-use surfmap_store::{ArtifactRef, JobFilter, JobRecord, JobState};
+use surfmap_store::{ArtifactRef, JobRecord};
 use tonic::{Request, Response, Status};
 
 /// The gRPC service over the shared state.
@@ -85,19 +84,7 @@ impl Surfmap for GrpcApi {
     async fn list_jobs(&self, req: Request<pb::ListJobsRequest>) -> Result<Response<pb::ListJobsResponse>, Status> {
         let o = owner(&self.state, &req)?;
         let r = req.into_inner();
-        let state = match r.state.as_str() {
-            "" => None,
-            s => Some(
-                JobState::parse(s)
-                    .ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?,
-            ),
-        };
-        let filter = JobFilter {
-            state,
-            method: Some(r.method).filter(|m| !m.is_empty()),
-            before: Some(r.cursor).filter(|c| !c.is_empty()),
-            limit: i64::from(r.limit),
-        };
+        let filter = job_filter(&r.state, &r.method, &r.cursor, i64::from(r.limit))?;
         let (jobs, next) = self.state.service.list(&o, filter).await?;
         Ok(Response::new(pb::ListJobsResponse {
             jobs: jobs.iter().map(job).collect(),
@@ -138,22 +125,18 @@ impl Surfmap for GrpcApi {
         let r = req.into_inner();
         let (a, bytes) = self.state.service.artifact(&o, &r.job_id, &r.name).await?;
         let total = bytes.len() as u64;
-        let chunks: Vec<Result<pb::ArtifactChunk, Status>> = bytes
-            .chunks(CHUNK)
-            .enumerate()
-            .map(|(i, c)| {
+        // At least one chunk, so an empty artifact still reports its content type.
+        let n = bytes.len().div_ceil(CHUNK).max(1);
+        let chunks: Vec<Result<pb::ArtifactChunk, Status>> = (0..n)
+            .map(|i| {
+                let first = i == 0;
                 Ok(pb::ArtifactChunk {
-                    content_type: if i == 0 { a.content_type.clone() } else { String::new() },
-                    total_size: if i == 0 { total } else { 0 },
-                    data: c.to_vec(),
+                    content_type: if first { a.content_type.clone() } else { String::new() },
+                    total_size: if first { total } else { 0 },
+                    data: bytes[i * CHUNK..((i + 1) * CHUNK).min(bytes.len())].to_vec(),
                 })
             })
             .collect();
-        let chunks = if chunks.is_empty() {
-            vec![Ok(pb::ArtifactChunk { content_type: a.content_type, total_size: 0, data: Vec::new() })]
-        } else {
-            chunks
-        };
         Ok(Response::new(Box::pin(futures::stream::iter(chunks))))
     }
 }

@@ -6,9 +6,9 @@ use crate::views::MeshView;
 use futures::Stream;
 use geom::io::{Format, ReadOptions};
 use geom::mesh::MeshLimits;
-use geom::pipeline::{JobSpec, Method};
+use geom::pipeline::JobSpec;
 use std::time::Duration;
-use surfmap_store::{ArtifactRef, BlobStore, JobFilter, JobRecord, MeshRecord, NewJob, Store, now_ms};
+use surfmap_store::{ArtifactRef, BlobStore, JobFilter, JobRecord, JobState, MeshRecord, NewJob, Store, now_ms};
 
 /// Sizes and retry policy the service enforces.
 #[derive(Debug, Clone)]
@@ -59,6 +59,26 @@ fn parse_format(hint: Option<&str>) -> Result<Option<Format>, ApiError> {
             ));
         }
     })
+}
+
+/// The format a file name's extension names, as a hint for ambiguous content.
+pub fn format_hint(file_name: Option<&str>) -> Option<&'static str> {
+    file_name.and_then(|f| Format::from_extension(std::path::Path::new(f))).map(Format::name)
+}
+
+/// Filters of a job listing from its request fields (empty = no filter).
+///
+/// # Errors
+/// 400 `invalid_query` for an unknown state.
+pub fn job_filter(state: &str, method: &str, cursor: &str, limit: i64) -> Result<JobFilter, ApiError> {
+    let state = match state {
+        "" => None,
+        s => Some(
+            JobState::parse(s).ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?,
+        ),
+    };
+    let some = |s: &str| Some(s.to_string()).filter(|s| !s.is_empty());
+    Ok(JobFilter { state, method: some(method), before: some(cursor), limit })
 }
 
 /// Parses a spec, naming an unknown method before any other field.
@@ -143,10 +163,7 @@ impl JobService {
         let ss = self.summary(owner, "source", source).await?;
         let ts = self.summary(owner, "target", target).await?;
         spec.check(&ss, &ts)?;
-        let method = match spec.method {
-            Method::Voronoi => "voronoi",
-            Method::Greedy => "greedy",
-        };
+        let method = spec.method.name();
         let job = NewJob {
             owner: owner.to_string(),
             idempotency_key: idempotency_key.filter(|k| !k.is_empty()),

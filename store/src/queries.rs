@@ -263,20 +263,14 @@ impl Store {
     /// Database failures.
     pub async fn claim(&self, worker: &str, lease_ms: i64) -> Result<Option<Claim>> {
         let now = now_ms();
-        let row = match &self.db {
-            Db::Sqlite(p) => {
-                match sqlx::query(CLAIM_SQLITE).bind(worker).bind(now + lease_ms).bind(now).fetch_optional(p).await? {
-                    Some(r) => Some(job_from_row!(&r)),
-                    None => None,
-                }
-            }
-            Db::Postgres(p) => {
-                match sqlx::query(CLAIM_POSTGRES).bind(worker).bind(now + lease_ms).bind(now).fetch_optional(p).await? {
-                    Some(r) => Some(job_from_row!(&r)),
-                    None => None,
-                }
-            }
+        let sql = match self.db {
+            Db::Sqlite(_) => CLAIM_SQLITE,
+            Db::Postgres(_) => CLAIM_POSTGRES,
         };
+        let row = on!(self, p => match sqlx::query(sql).bind(worker).bind(now + lease_ms).bind(now).fetch_optional(p).await? {
+            Some(r) => Some(job_from_row!(&r)),
+            None => None,
+        });
         Ok(row.map(|job| Claim { fence: job.fence, job }))
     }
 

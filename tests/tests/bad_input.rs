@@ -1,10 +1,12 @@
 //! One test per class of bad input against the real server: each answers 4xx with a clear
 //! code and message (or the matching gRPC status), and the server stays up.
 
+mod common;
+
+use common::{Api, Env, SMPL, identity_spec, shared};
 use futures::StreamExt;
 use serde_json::{Value, json};
 use std::time::Duration;
-use surfmap_e2e::{Api, Env, SMPL, identity_spec, shared};
 use surfmap_proto::v1 as pb;
 use surfmap_proto::v1::surfmap_client::SurfmapClient;
 

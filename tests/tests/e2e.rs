@@ -2,10 +2,12 @@
 //! on a temporary SQLite file and, when `SURFMAP_TEST_POSTGRES_URL` is set, on PostgreSQL.
 //! Scenarios run one at a time (they start several processes each on a 2-core machine).
 
+mod common;
+
+use common::{Api, Env, SMPL, assert_metrics_agree, evaluate, identity_spec, shared, wait_for};
 use futures::StreamExt;
 use serde_json::{Value, json};
 use std::time::Duration;
-use surfmap_e2e::{Api, Env, SMPL, assert_metrics_agree, evaluate, identity_spec, shared, wait_for};
 use surfmap_proto::v1 as pb;
 use surfmap_proto::v1::surfmap_client::SurfmapClient;
 
@@ -210,7 +212,7 @@ async fn crash(env: &Env) {
     let (_server, base) = env.server(&["--workers", "0", "--lease-secs", "2"]);
     let api = Api::new(&base);
     let (src, tgt) = upload_pair(&api).await;
-    let ports = [surfmap_e2e::free_port(), surfmap_e2e::free_port()];
+    let ports = [common::free_port(), common::free_port()];
     let listen = ports.map(|p| format!("127.0.0.1:{p}"));
     let a = env.worker("a", &["--lease-secs", "2", "--metrics-listen", &listen[0]]);
     let b = env.worker("b", &["--lease-secs", "2", "--metrics-listen", &listen[1]]);

@@ -1,8 +1,10 @@
 //! `deploy/smoke.sh`, the script users' CI runs against a deployment, run here against the
 //! real server with in-process workers (and a bearer token, as a deployment would have).
 
+mod common;
+
+use common::Env;
 use std::process::Command;
-use surfmap_e2e::Env;
 
 #[test]
 fn smoke_script_passes_against_a_local_server() {

@@ -3,7 +3,7 @@
 use super::{Owner, P, Q, is_multipart, multipart_error, read_limited};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
-use crate::service::parse_spec;
+use crate::service::{format_hint, job_filter, parse_spec};
 use crate::views::{JobPage, JobView, SubmitJob, job_view};
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
@@ -12,7 +12,7 @@ use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
 use futures::{Stream, StreamExt};
 use std::convert::Infallible;
-use surfmap_store::{BlobStore, JobFilter, JobState};
+use surfmap_store::BlobStore;
 
 /// Filters and paging of `GET /v1/jobs`.
 #[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
@@ -33,9 +33,7 @@ async fn mesh_part(st: &AppState, owner: &str, bytes: &[u8], file_name: Option<S
     if file_name.is_none() && BlobStore::valid_key(text) {
         return Ok(text.to_string());
     }
-    let hint = file_name.and_then(|f| f.rsplit_once('.').map(|(_, e)| e.to_ascii_lowercase()));
-    let hint = hint.filter(|e| ["obj", "off", "ply", "stl"].contains(&e.as_str()));
-    Ok(st.service.upload_mesh(owner, bytes.to_vec(), hint.as_deref()).await?.id)
+    Ok(st.service.upload_mesh(owner, bytes.to_vec(), format_hint(file_name.as_deref())).await?.id)
 }
 
 async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<(String, String, Vec<u8>), ApiError> {
@@ -111,18 +109,12 @@ pub async fn list_jobs(
     Owner(owner): Owner,
     Q(q): Q<ListQuery>,
 ) -> Result<Json<JobPage>, ApiError> {
-    let state = match q.state.as_deref() {
-        None | Some("") => None,
-        Some(s) => Some(
-            JobState::parse(s).ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?,
-        ),
-    };
-    let filter = JobFilter {
-        state,
-        method: q.method.filter(|m| !m.is_empty()),
-        before: q.cursor.filter(|c| !c.is_empty()),
-        limit: q.limit.unwrap_or(50),
-    };
+    let filter = job_filter(
+        q.state.as_deref().unwrap_or_default(),
+        q.method.as_deref().unwrap_or_default(),
+        q.cursor.as_deref().unwrap_or_default(),
+        q.limit.unwrap_or(50),
+    )?;
     let (jobs, next_cursor) = st.service.list(&owner, filter).await?;
     Ok(Json(JobPage { jobs: jobs.iter().map(job_view).collect(), next_cursor }))
 }

@@ -3,6 +3,7 @@
 use super::{Owner, Q, is_multipart, multipart_error, read_limited};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
+use crate::service::format_hint;
 use crate::views::MeshView;
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
@@ -16,13 +17,12 @@ pub struct FormatQuery {
 }
 
 /// The first file part of a multipart body and the format its file name suggests.
-pub async fn first_file(mut mp: Multipart) -> Result<(Vec<u8>, Option<String>), ApiError> {
+pub async fn first_file(mut mp: Multipart) -> Result<(Vec<u8>, Option<&'static str>), ApiError> {
     while let Some(field) = mp.next_field().await.map_err(multipart_error)? {
-        let ext = field.file_name().and_then(|f| f.rsplit_once('.')).map(|(_, e)| e.to_ascii_lowercase());
-        let named = matches!(field.name(), Some("file" | "mesh"));
-        if named || ext.is_some() {
+        let hint = format_hint(field.file_name());
+        if matches!(field.name(), Some("file" | "mesh")) || field.file_name().is_some() {
             let bytes = field.bytes().await.map_err(multipart_error)?;
-            return Ok((bytes.to_vec(), ext));
+            return Ok((bytes.to_vec(), hint));
         }
     }
     Err(ApiError::bad_request("invalid_multipart", "no file part (name it \"file\")"))
@@ -47,7 +47,7 @@ pub async fn upload_mesh(
         let (parts, body) = req.into_parts();
         (read_limited(&parts.headers, body, st.service.limits.max_body_bytes).await?.to_vec(), None)
     };
-    let hint = q.format.or(ext.filter(|e| ["obj", "off", "ply", "stl"].contains(&e.as_str())));
-    let view = st.service.upload_mesh(&owner, bytes, hint.as_deref()).await?;
+    let hint = q.format.as_deref().or(ext);
+    let view = st.service.upload_mesh(&owner, bytes, hint).await?;
     Ok((StatusCode::CREATED, Json(view)))
 }

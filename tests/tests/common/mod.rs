@@ -1,6 +1,9 @@
-//! The end-to-end harness: start the real binaries (found next to this test in the target
-//! directory; `cargo test --workspace` builds them, since the server and worker packages have
-//! tests of their own) on port 0, talk to them, and check results with the shared evaluator.
+//! The end-to-end harness, shared by the test files (each uses part of it): start the real
+//! binaries (found next to this test in the target directory; `cargo test --workspace` builds
+//! them, since the server and worker packages have tests of their own) on port 0, talk to them,
+//! and check results with the shared evaluator. Failures here panic: they fail the test.
+
+#![allow(dead_code)]
 
 use serde_json::{Value, json};
 use std::io::{BufRead, BufReader};

@@ -29,10 +29,26 @@ pub fn inspect(path: &Path) -> Result<String> {
     serde_json::to_string_pretty(&v).map_err(|e| Error::Internal(e.to_string()))
 }
 
-/// `surfmap convert IN OUT`.
-pub fn convert(input: &Path, output: &Path, subdivide: usize) -> Result<String> {
+/// `surfmap convert IN OUT [--subdivide K] [--simplify N [--kept FILE]]`.
+pub fn convert(
+    input: &Path,
+    output: &Path,
+    subdivide: usize,
+    simplify: Option<usize>,
+    kept: Option<&Path>,
+) -> Result<String> {
     let r = read(input)?;
-    let mesh = if subdivide > 0 { geom::mesh::shapes::try_subdivide(&r.mesh, subdivide)? } else { r.mesh };
+    let mut mesh = if subdivide > 0 { geom::mesh::shapes::try_subdivide(&r.mesh, subdivide)? } else { r.mesh };
+    if let Some(n) = simplify {
+        let opts = geom::simplify::DecimateOptions { target_vertices: n, ..Default::default() };
+        let d = geom::simplify::decimate(&mesh, &opts)?;
+        if let Some(path) = kept {
+            let text: String = d.kept.iter().map(|v| format!("{}\n", v.0)).collect();
+            std::fs::write(path, text)
+                .map_err(|e| InputError::Invalid(format!("cannot write {}: {e}", path.display())))?;
+        }
+        mesh = d.mesh;
+    }
     io::write_path(&mesh, output)?;
     let s = geom::topology::summary(&mesh);
     Ok(json!({"written": output.display().to_string(), "vertices": s.vertices, "faces": s.faces,

@@ -28,6 +28,13 @@ enum Command {
         /// Split every triangle into four at edge midpoints, this many times.
         #[arg(long, default_value_t = 0)]
         subdivide: usize,
+        /// Then simplify to this many vertices by quadric-error half-edge collapses (every output
+        /// vertex is an input vertex).
+        #[arg(long)]
+        simplify: Option<usize>,
+        /// With --simplify: write the input index of every output vertex here, one per line.
+        #[arg(long, requires = "simplify")]
+        kept: Option<PathBuf>,
     },
     /// Measure a map given as SOURCE re-embedded on TARGET (MAPPED has SOURCE's faces).
     Metrics {
@@ -78,7 +85,9 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Inspect { mesh } => commands::inspect(&mesh),
-        Command::Convert { input, output, subdivide } => commands::convert(&input, &output, subdivide),
+        Command::Convert { input, output, subdivide, simplify, kept } => {
+            commands::convert(&input, &output, subdivide, simplify, kept.as_deref())
+        }
         Command::Metrics { source, target, mapped, anchors, gt, samples, seed } => {
             commands::metrics(&source, &target, &mapped, anchors.as_deref(), gt.as_deref(), samples, seed)
         }

@@ -22,6 +22,7 @@ pub mod metrics;
 pub mod param;
 pub mod pipeline;
 pub mod progress;
+pub mod simplify;
 pub mod tol;
 pub mod topology;
 

@@ -13,6 +13,7 @@ use crate::linalg::{FixedBoundarySystem, Weights};
 use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::param::{BoundaryShape, Uv, check_injective, disk_boundary, map_boundary_to_polygon};
 use crate::progress::Progress;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Options for [`parameterize_patches`].
@@ -69,70 +70,91 @@ pub fn parameterize_patches(
     for (f, &p) in r.patch.iter().enumerate() {
         faces_of[p as usize].push(f);
     }
-    let mut out = Vec::with_capacity(patches.len());
-    let mut local_of = vec![u32::MAX; r.mesh.n_vertices()];
-    for (pi, (patch, faces)) in patches.iter().zip(&faces_of).enumerate() {
-        progress.check()?;
-        progress.report("parameterize", pi as f64 / patches.len().max(1) as f64);
-        let mut global_v = Vec::new();
-        let mut tris = Vec::with_capacity(faces.len());
-        for &f in faces {
-            let t = r.mesh.face(FaceId::from_idx(f)).map(|v| {
-                if local_of[v.idx()] == u32::MAX {
-                    local_of[v.idx()] = global_v.len() as u32;
-                    global_v.push(v);
-                }
-                local_of[v.idx()]
-            });
-            tris.push(t);
-        }
-        for v in &global_v {
-            local_of[v.idx()] = u32::MAX;
-        }
-        let positions = global_v.iter().map(|&v| r.mesh.position(v)).collect();
-        let local = Mesh::from_triangles(positions, &tris)
-            .map_err(|e| Error::Numerical(format!("patch {pi} is not a valid mesh: {e}")))?;
-        let mut lp = disk_boundary(&local).map_err(|e| Error::Numerical(format!("patch {pi}: {e}")))?;
-        let corner_local = |a: u32| {
-            let v = anchors[a as usize];
-            global_v.iter().position(|&g| g == v).map(VertexId::from_idx)
-        };
-        let c = patch.corners.map(corner_local);
-        let [Some(c0), Some(c1), Some(c2)] = c else {
-            return Err(Error::Numerical(format!("patch {pi} does not contain its corners")));
-        };
-        let Some(s) = lp.iter().position(|&v| v == c0) else {
-            return Err(Error::Numerical(format!("corner of patch {pi} is not on its boundary")));
-        };
-        lp.rotate_left(s);
-        let p2 = lp.iter().position(|&v| v == c2);
-        let p1 = lp.iter().position(|&v| v == c1);
-        let (Some(p2), Some(p1)) = (p2, p1) else {
-            return Err(Error::Numerical(format!("corner of patch {pi} is not on its boundary")));
-        };
-        if !(0 < p2 && p2 < p1) {
-            return Err(Error::Numerical(format!("patch {pi} has its corners in the wrong order")));
-        }
-        let shape = BoundaryShape::Polygon { vertices: TRIANGLE.to_vec(), corners: Some(vec![0, p2, p1]) };
-        let buv = map_boundary_to_polygon(&local, &lp, &shape)?;
-        let mut fixed = vec![[f64::NAN; 2]; local.n_vertices()];
-        for (v, p) in lp.iter().zip(&buv) {
-            fixed[v.idx()] = *p;
-        }
-        let (uv, residual) = if lp.len() == local.n_vertices() {
-            (fixed.clone(), 0.0)
-        } else {
-            let mut sys = FixedBoundarySystem::new(&local, &lp)?;
-            let fac = sys.factor(&local, opts.weights)?;
-            fac.solve_with_residual::<2>(&|v| fixed[v.idx()])?
-        };
-        let inj = check_injective(&local, &uv);
-        if inj.flipped > 0 {
-            return Err(Error::Numerical(format!("patch {pi} folds: {} flipped triangles", inj.flipped)));
-        }
-        let grid = Grid::new(&uv, &tris);
-        let global_f = faces.iter().map(|&f| FaceId::from_idx(f)).collect();
-        out.push(PatchParam { local, global_v, global_f, uv, boundary: lp, tris, grid, residual });
-    }
+    progress.check()?;
+    progress.report("parameterize", 0.0);
+    // Patches are independent: flatten them in parallel, one vertex-renumbering scratch per
+    // worker thread.
+    let out = patches
+        .par_iter()
+        .zip(faces_of.par_iter())
+        .enumerate()
+        .map_init(
+            || vec![u32::MAX; r.mesh.n_vertices()],
+            |local_of, (pi, (patch, faces))| flatten_patch(r, pi, patch, faces, anchors, opts, local_of),
+        )
+        .collect::<Result<Vec<_>>>()?;
+    progress.report("parameterize", 1.0);
     Ok(out)
+}
+
+/// Flattens patch `pi` (its `faces` of `r`) onto [`TRIANGLE`]; `local_of` is all `u32::MAX`
+/// on entry and on return.
+fn flatten_patch(
+    r: &Refined,
+    pi: usize,
+    patch: &Patch,
+    faces: &[usize],
+    anchors: &[VertexId],
+    opts: &PatchParamOptions,
+    local_of: &mut [u32],
+) -> Result<PatchParam> {
+    let mut global_v = Vec::new();
+    let mut tris = Vec::with_capacity(faces.len());
+    for &f in faces {
+        let t = r.mesh.face(FaceId::from_idx(f)).map(|v| {
+            if local_of[v.idx()] == u32::MAX {
+                local_of[v.idx()] = global_v.len() as u32;
+                global_v.push(v);
+            }
+            local_of[v.idx()]
+        });
+        tris.push(t);
+    }
+    for v in &global_v {
+        local_of[v.idx()] = u32::MAX;
+    }
+    let positions = global_v.iter().map(|&v| r.mesh.position(v)).collect();
+    let local = Mesh::from_triangles(positions, &tris)
+        .map_err(|e| Error::Numerical(format!("patch {pi} is not a valid mesh: {e}")))?;
+    let mut lp = disk_boundary(&local).map_err(|e| Error::Numerical(format!("patch {pi}: {e}")))?;
+    let corner_local = |a: u32| {
+        let v = anchors[a as usize];
+        global_v.iter().position(|&g| g == v).map(VertexId::from_idx)
+    };
+    let c = patch.corners.map(corner_local);
+    let [Some(c0), Some(c1), Some(c2)] = c else {
+        return Err(Error::Numerical(format!("patch {pi} does not contain its corners")));
+    };
+    let Some(s) = lp.iter().position(|&v| v == c0) else {
+        return Err(Error::Numerical(format!("corner of patch {pi} is not on its boundary")));
+    };
+    lp.rotate_left(s);
+    let p2 = lp.iter().position(|&v| v == c2);
+    let p1 = lp.iter().position(|&v| v == c1);
+    let (Some(p2), Some(p1)) = (p2, p1) else {
+        return Err(Error::Numerical(format!("corner of patch {pi} is not on its boundary")));
+    };
+    if !(0 < p2 && p2 < p1) {
+        return Err(Error::Numerical(format!("patch {pi} has its corners in the wrong order")));
+    }
+    let shape = BoundaryShape::Polygon { vertices: TRIANGLE.to_vec(), corners: Some(vec![0, p2, p1]) };
+    let buv = map_boundary_to_polygon(&local, &lp, &shape)?;
+    let mut fixed = vec![[f64::NAN; 2]; local.n_vertices()];
+    for (v, p) in lp.iter().zip(&buv) {
+        fixed[v.idx()] = *p;
+    }
+    let (uv, residual) = if lp.len() == local.n_vertices() {
+        (fixed.clone(), 0.0)
+    } else {
+        let mut sys = FixedBoundarySystem::new(&local, &lp)?;
+        let fac = sys.factor(&local, opts.weights)?;
+        fac.solve_with_residual::<2>(&|v| fixed[v.idx()])?
+    };
+    let inj = check_injective(&local, &uv);
+    if inj.flipped > 0 {
+        return Err(Error::Numerical(format!("patch {pi} folds: {} flipped triangles", inj.flipped)));
+    }
+    let grid = Grid::new(&uv, &tris);
+    let global_f = faces.iter().map(|&f| FaceId::from_idx(f)).collect();
+    Ok(PatchParam { local, global_v, global_f, uv, boundary: lp, tris, grid, residual })
 }

@@ -55,13 +55,18 @@ impl SmoothReport {
     }
 }
 
-/// Symmetric Dirichlet energy of the affine map from source triangle `s` to mapped `m`, times
-/// the source area; `None` for a degenerate mapped triangle.
-fn tri_energy(s: [P3; 3], m: [P3; 3], scale: f64) -> Option<f64> {
-    let m = m.map(|p| P3::from(p.coords * scale));
-    let frame = |p: [P3; 3]| {
-        let e1 = p[1] - p[0];
-        let e2 = p[2] - p[0];
+/// A source triangle in its own orthonormal frame: `S^-1 = [[a, b], [0, c]]` (the inverse of
+/// the upper-triangular matrix of its edges) and its area.
+#[derive(Debug, Clone, Copy)]
+struct SourceFrame {
+    inv: [f64; 3],
+    area: f64,
+}
+
+impl SourceFrame {
+    fn new(s: [P3; 3]) -> Option<Self> {
+        let e1 = s[1] - s[0];
+        let e2 = s[2] - s[0];
         let l = e1.norm();
         let n = e1.cross(&e2);
         let nn = n.norm();
@@ -69,21 +74,26 @@ fn tri_energy(s: [P3; 3], m: [P3; 3], scale: f64) -> Option<f64> {
             return None;
         }
         let x = e1 / l;
-        let y = (n / nn).cross(&x);
-        Some(([l, e2.dot(&x)], [0.0, e2.dot(&y)], 0.5 * nn))
-    };
-    let (s0, s1, area_s) = frame(s)?;
-    let (m0, m1, _) = frame(m)?;
-    // J = M S^-1 with S = [[s0.0, s0.1],[s1.0, s1.1]] (upper triangular).
-    let det_s = s0[0] * s1[1];
-    let inv = [[1.0 / s0[0], -s0[1] / det_s], [0.0, 1.0 / s1[1]]];
-    let j = [[m0[0] * inv[0][0], m0[0] * inv[0][1] + m0[1] * inv[1][1]], [0.0, m1[1] * inv[1][1]]];
-    let fro = j[0][0].powi(2) + j[0][1].powi(2) + j[1][1].powi(2);
-    let det = j[0][0] * j[1][1];
-    if det <= 0.0 {
-        return None;
+        let (e2x, e2y) = (e2.dot(&x), (n / nn).cross(&x).dot(&e2));
+        Some(Self { inv: [1.0 / l, -e2x / (l * e2y), 1.0 / e2y], area: 0.5 * nn })
     }
-    Some(area_s * (fro + fro / (det * det)))
+
+    /// Symmetric Dirichlet energy of the affine map onto the mapped triangle `m` (scaled by
+    /// `scale`), times the source area: `|J|² + |J⁻¹|²` with `J = [m1 - m0, m2 - m0] S⁻¹`
+    /// (3x2), so `|J⁻¹|² = |J|² / det(JᵀJ)`. `None` for a degenerate mapped triangle.
+    fn energy(&self, m: [P3; 3], scale: f64) -> Option<f64> {
+        let [a, b, c] = self.inv;
+        let (e1, e2) = ((m[1] - m[0]) * scale, (m[2] - m[0]) * scale);
+        let c0 = e1 * a;
+        let c1 = e1 * b + e2 * c;
+        let (n0, n1, d) = (c0.norm_squared(), c1.norm_squared(), c0.dot(&c1));
+        let fro = n0 + n1;
+        let det2 = n0 * n1 - d * d;
+        if det2 <= 0.0 || !det2.is_finite() {
+            return None;
+        }
+        Some(self.area * (fro + fro / det2))
+    }
 }
 
 /// Faces of `v`'s star in `source` that face against `target` at all their corners (the
@@ -136,6 +146,8 @@ pub fn smooth(
     // The target's normal at each image, from the face it lies on.
     let tnormal = |f: FaceId| -> V3 { target.face_normal_raw(f) };
     let mut img_face: Vec<FaceId> = map.face.clone();
+    let frames: Vec<Option<SourceFrame>> =
+        (0..source.n_faces()).map(|f| SourceFrame::new(source.face_points(FaceId::from_idx(f)))).collect();
     let star_energy = |v: VertexId, pos: &[P3], img_face: &[FaceId], p: P3, f: FaceId| -> Option<f64> {
         let mut e = 0.0;
         for h in source.outgoing(v) {
@@ -150,7 +162,7 @@ pub fn smooth(
             if nm.dot(&tnormal(f)) <= 0.0 {
                 return None;
             }
-            e += tri_energy(source.face_points(h.face()), m, scale)?;
+            e += frames[h.face().idx()]?.energy(m, scale)?;
         }
         Some(e)
     };
@@ -158,7 +170,7 @@ pub fn smooth(
         (0..source.n_faces())
             .filter_map(|f| {
                 let tri = source.face(FaceId::from_idx(f));
-                tri_energy(source.face_points(FaceId::from_idx(f)), tri.map(|w| pos[w.idx()]), scale)
+                frames[f]?.energy(tri.map(|w| pos[w.idx()]), scale)
             })
             .sum::<f64>()
     };

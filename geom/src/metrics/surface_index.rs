@@ -111,7 +111,9 @@ impl<'m> SurfaceIndex<'m> {
     /// turn, e.g. Morton order). Each search is bounded by the previous point's k-th candidate
     /// distance plus the step between the points: by the triangle inequality at least k
     /// centroids lie inside, so the candidate set, and so the distance, is the same as an
-    /// unbounded search. One scratch buffer serves every search.
+    /// unbounded search. One scratch buffer serves every search. Only the distance is returned,
+    /// which is the minimum over the candidate set whatever its order, so the searches skip
+    /// sorting.
     pub fn distances_in_order(&self, pts: &[P3], order: &[usize]) -> Vec<f64> {
         let mut out = vec![0.0; pts.len()];
         let mut scratch = self.tree.create_scratch::<SquaredEuclidean<f64>>();
@@ -126,6 +128,7 @@ impl<'m> SurfaceIndex<'m> {
                     .query(&q)
                     .nearest_n::<SquaredEuclidean<f64>>(self.k)
                     .within(r * r)
+                    .unsorted()
                     .with_scratch(&mut scratch)
                     .execute();
                 // Always k by the triangle inequality; the fallback only guards degenerate input.
@@ -133,12 +136,18 @@ impl<'m> SurfaceIndex<'m> {
             });
             let cand = match bounded {
                 Some(c) => c,
-                None => {
-                    self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).with_scratch(&mut scratch).execute()
-                }
+                None => self
+                    .tree
+                    .query(&q)
+                    .nearest_n::<SquaredEuclidean<f64>>(self.k)
+                    .unsorted()
+                    .with_scratch(&mut scratch)
+                    .execute(),
             };
-            if let Some(last) = cand.last() {
-                hint = Some((*p, last.distance.sqrt()));
+            // Unsorted: the k-th distance is the largest.
+            let dk = cand.iter().map(|n| n.distance).fold(f64::NEG_INFINITY, f64::max);
+            if dk.is_finite() {
+                hint = Some((*p, dk.sqrt()));
             }
             out[i] = self.best_of(p, cand.iter().map(|n| (n.item, n.distance))).distance;
         }

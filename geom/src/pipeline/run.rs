@@ -48,6 +48,16 @@ impl Clock {
     }
 }
 
+/// Runs `side` on a scoped thread while `main` runs here: the source and target halves of a
+/// stage are independent. The side half reports no progress (the main half does).
+fn both<A: Send, B>(side: impl FnOnce() -> A + Send, main: impl FnOnce() -> B) -> Result<(B, A)> {
+    std::thread::scope(|sc| {
+        let h = sc.spawn(side);
+        let b = main();
+        Ok((b, h.join().map_err(|_| Error::Internal("worker thread panicked".into()))?))
+    })
+}
+
 /// The maps both ways, with what produced them.
 pub struct MapResult {
     pub source_to_target: SurfaceMap,
@@ -78,8 +88,8 @@ pub fn run_map(
     let mut edge_nodes = o.layout.edge_nodes;
     let mut attempt = 0;
     let (st, tt, stats) = loop {
-        let mut st = Tracer::new(source, &sa, &edge_nodes)?;
-        let mut tt = Tracer::new(target, &ta, &edge_nodes)?;
+        let (st, tt) = both(|| Tracer::new(target, &ta, &edge_nodes), || Tracer::new(source, &sa, &edge_nodes))?;
+        let (mut st, mut tt) = (st?, tt?);
         let built = match spec.method {
             Method::Voronoi => voronoi::source_layout(&mut st, chi, &o.layout, progress).and_then(|(cl, mut s)| {
                 let t = voronoi::target_layout_with_restarts(&st, &cl, &mut tt, &o.layout, 8, progress)?;
@@ -115,48 +125,61 @@ pub fn run_map(
     };
     clock.lap("layout");
     let (mut st, mut tt, mut stats) = (st, tt, stats);
-    stats.straightened = crate::domain::straighten::straighten(&mut st, o.layout.straighten_rounds, progress)?
-        + crate::domain::straighten::straighten(&mut tt, o.layout.straighten_rounds, progress)?;
+    let rounds = o.layout.straighten_rounds;
+    let (a, b) = both(
+        || crate::domain::straighten::straighten(&mut tt, rounds, &mut crate::progress::NoProgress),
+        || crate::domain::straighten::straighten(&mut st, rounds, progress),
+    )?;
+    stats.straightened = a? + b?;
     clock.lap("straighten");
     let patches = patches_of(&st);
     stats.patches = patches.len();
     progress.check()?;
-    let rs = refine(&st, &patches)?;
-    let rt = refine(&tt, &patches)?;
+    // The target tracer moves to the side thread (its scratch is not `Sync`).
+    let (tt_ref, pr) = (&mut tt, &patches);
+    let (rs, rt) = both(move || refine(tt_ref, pr), || refine(&st, &patches))?;
+    let (rs, rt) = (rs?, rt?);
     clock.lap("refine");
-    let ps = parameterize_patches(&rs, &patches, &sa, &o.param, progress)?;
-    let pt = parameterize_patches(&rt, &patches, &ta, &o.param, progress)?;
+    let (ps, pt) = both(
+        || parameterize_patches(&rt, &patches, &ta, &o.param, &mut crate::progress::NoProgress),
+        || parameterize_patches(&rs, &patches, &sa, &o.param, progress),
+    )?;
+    let (ps, pt) = (ps?, pt?);
     clock.lap("parameterize");
     progress.report("compose", 0.0);
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
-    let s2t = compose(&ps, source, &rt, &pt, target, &pairs);
-    let t2s = compose(&pt, target, &rs, &ps, source, &rev);
+    let (s2t, t2s) =
+        both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
     clock.lap("compose");
     progress.check()?;
     // The two directions are independent: smooth them on two threads.
-    let (a, b) = std::thread::scope(|sc| {
-        let h = sc.spawn(|| smooth::smooth(target, source, t2s, &ta, &o.smoothing, &mut crate::progress::NoProgress));
-        let a = smooth::smooth(source, target, s2t, &sa, &o.smoothing, progress);
-        (a, h.join().map_err(|_| Error::Internal("smoothing thread panicked".into())))
-    });
-    let (s2t, r1) = a?;
-    let (mut t2s, r2) = b??;
-    let mut s2t = s2t;
-    let visible = crate::crossparam::visible::make_visible(source, target, &mut s2t, &sa)?
-        + crate::crossparam::visible::make_visible(target, source, &mut t2s, &ta)?;
+    let (a, b) = both(
+        || {
+            let (mut m, r) = smooth::smooth(target, source, t2s, &ta, &o.smoothing, &mut crate::progress::NoProgress)?;
+            let v = crate::crossparam::visible::make_visible(target, source, &mut m, &ta)?;
+            Ok::<_, Error>((m, r, v))
+        },
+        || {
+            let (mut m, r) = smooth::smooth(source, target, s2t, &sa, &o.smoothing, progress)?;
+            let v = crate::crossparam::visible::make_visible(source, target, &mut m, &sa)?;
+            Ok::<_, Error>((m, r, v))
+        },
+    )?;
+    let ((s2t, r1, v1), (t2s, r2, v2)) = (a?, b?);
+    let visible = v1 + v2;
     clock.lap("smooth");
     progress.check()?;
     let result = MapResult { source_to_target: s2t, target_to_source: t2s };
-    let on_target = result.source_to_target.embed(source, target)?;
-    let on_source = result.target_to_source.embed(target, source)?;
+    let (on_target, on_source) =
+        both(|| result.target_to_source.embed(target, source), || result.source_to_target.embed(source, target))?;
+    let (on_target, on_source) = (on_target?, on_source?);
     progress.report("metrics", 0.0);
     let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
-    let (m1, m2) = std::thread::scope(|sc| {
-        let h = sc.spawn(|| evaluate_map(target, source, &on_source, Some(&rev), None, &mo));
-        let m1 = evaluate_map(source, target, &on_target, Some(&pairs), None, &mo);
-        (m1, h.join().map_err(|_| Error::Internal("metrics thread panicked".into())))
-    });
-    let (m1, m2) = (m1?, m2??);
+    let (m1, m2) = both(
+        || evaluate_map(target, source, &on_source, Some(&rev), None, &mo),
+        || evaluate_map(source, target, &on_target, Some(&pairs), None, &mo),
+    )?;
+    let (m1, m2) = (m1?, m2?);
     clock.lap("metrics");
     progress.check()?;
     let mut report = MapReport {

@@ -9,9 +9,11 @@ use super::locate2d::Grid;
 use crate::domain::Patch;
 use crate::domain::refine::Refined;
 use crate::error::{Error, Result};
-use crate::linalg::{FixedBoundarySystem, Weights};
+use crate::linalg::{FixedBoundarySystem, Weights, directed_weights};
 use crate::mesh::{FaceId, Mesh, VertexId};
-use crate::param::{BoundaryShape, Uv, check_injective, disk_boundary, map_boundary_to_polygon};
+use crate::param::{
+    BoundaryShape, StretchOptions, Uv, check_injective, disk_boundary, map_boundary_to_polygon, minimize_stretch,
+};
 use crate::progress::Progress;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -21,11 +23,15 @@ use serde::{Deserialize, Serialize};
 #[serde(default)]
 pub struct PatchParamOptions {
     pub weights: Weights,
+    /// Stretch-minimizing reweighting rounds after the first embedding (Yoshizawa et al.;
+    /// 0 keeps the plain mean-value map). Lower stretch on both meshes makes corresponding
+    /// patches agree where a mean-value map squeezes protrusions.
+    pub stretch_iterations: usize,
 }
 
 impl Default for PatchParamOptions {
     fn default() -> Self {
-        Self { weights: Weights::MeanValue }
+        Self { weights: Weights::MeanValue, stretch_iterations: 3 }
     }
 }
 
@@ -147,8 +153,20 @@ fn flatten_patch(
         (fixed.clone(), 0.0)
     } else {
         let mut sys = FixedBoundarySystem::new(&local, &lp)?;
-        let fac = sys.factor(&local, opts.weights)?;
-        fac.solve_with_residual::<2>(&|v| fixed[v.idx()])?
+        if !opts.weights.is_symmetric() {
+            sys.prepare_lu()?;
+        }
+        let w = directed_weights(&local, opts.weights);
+        let fac = sys.factor_weights(&w, opts.weights.is_symmetric())?;
+        let (uv, residual) = fac.solve_with_residual::<2>(&|v| fixed[v.idx()])?;
+        if opts.stretch_iterations > 0 && !opts.weights.is_symmetric() {
+            let so = StretchOptions { iterations: opts.stretch_iterations, ..Default::default() };
+            let r = minimize_stretch(&local, &sys, &w, uv, &|v| fixed[v.idx()], &so)?;
+            let res = if r.rounds > 0 { r.residual } else { residual };
+            (r.uv, res)
+        } else {
+            (uv, residual)
+        }
     };
     let inj = check_injective(&local, &uv);
     if inj.flipped > 0 {

@@ -1,13 +1,15 @@
 //! Stretch-reducing relocation of mapped vertices across patch boundaries, in the spirit of
 //! Kraevoy & Sheffer 2004, section 5. The patch-wise map is continuous but kinks where patches
 //! meet; here every free vertex's image moves, one at a time (Gauss-Seidel), towards the
-//! mean-value combination of its neighbours' images, and is projected back onto the target
+//! mean-value combination (weights of its source star) of its neighbours' images, and is
+//! projected back onto the target
 //! surface (BVH closest point). A move is kept only if it lowers the local symmetric Dirichlet
 //! stretch of the incident triangles (Sander's L2 plus its inverse, so triangles cannot
 //! collapse) and leaves every incident triangle facing the way the target does; so the result
 //! stays on the surface and flip-free, and anchors never move.
 
 use crate::error::Result;
+use crate::linalg::{Weights, directed_weights};
 use crate::map::SurfaceMap;
 use crate::mesh::{FaceId, Mesh, P3, V3, VertexId};
 use crate::progress::Progress;
@@ -143,6 +145,18 @@ pub fn smooth(
     for v in fixed {
         is_fixed[v.idx()] = true;
     }
+    // Boundary images stay where the patch maps put them: on the target's boundary.
+    for (v, f) in is_fixed.iter_mut().enumerate() {
+        *f |= source.is_boundary_vertex(VertexId::from_idx(v));
+    }
+    // Mean-value weight of each outgoing half-edge's head, from both faces beside the edge.
+    let dw = directed_weights(source, Weights::MeanValue);
+    let lambda: Vec<f64> = (0..source.n_halfedges())
+        .map(|h| {
+            let h = crate::HalfedgeId::from_idx(h);
+            dw.fwd[h.idx()] + source.twin(h).map_or(0.0, |t| dw.rev[t.idx()])
+        })
+        .collect();
     // The target's normal at each image, from the face it lies on.
     let tnormal = |f: FaceId| -> V3 { target.face_normal_raw(f) };
     let mut img_face: Vec<FaceId> = map.face.clone();
@@ -173,6 +187,53 @@ pub fn smooth(
                 frames[f]?.energy(tri.map(|w| pos[w.idx()]), scale)
             })
             .sum::<f64>()
+    };
+    // Newton step of the star energy (without the orientation test) over the tangent plane
+    // `p + a t1 + b t2`, by central differences at a tenth of a percent of the star's size;
+    // `None` where the Hessian is not positive definite.
+    let newton_goal = |v: VertexId, pos: &[P3], normal: V3| -> Option<P3> {
+        let p = pos[v.idx()];
+        let nl = normal.norm();
+        if nl <= 0.0 {
+            return None;
+        }
+        let n = normal / nl;
+        let t1 = if n.x.abs() < 0.9 { V3::x().cross(&n) } else { V3::y().cross(&n) }.normalize();
+        let t2 = n.cross(&t1);
+        let (mut reach, mut k) = (0.0, 0.0);
+        for w in source.vertex_neighbors(v) {
+            reach += (pos[w.idx()] - p).norm();
+            k += 1.0;
+        }
+        let reach = reach / f64::max(k, 1.0);
+        let h = 1e-3 * reach;
+        if h <= 0.0 {
+            return None;
+        }
+        let e = |a: f64, b: f64| -> Option<f64> {
+            let q = p + t1 * a + t2 * b;
+            let mut sum = 0.0;
+            for he in source.outgoing(v) {
+                let tri = source.face(he.face());
+                sum += frames[he.face().idx()]?.energy(tri.map(|w| if w == v { q } else { pos[w.idx()] }), scale)?;
+            }
+            Some(sum)
+        };
+        let e0 = e(0.0, 0.0)?;
+        let (ea, eb, ec, ed) = (e(h, 0.0)?, e(-h, 0.0)?, e(0.0, h)?, e(0.0, -h)?);
+        let g = [(ea - eb) / (2.0 * h), (ec - ed) / (2.0 * h)];
+        let h11 = (ea - 2.0 * e0 + eb) / (h * h);
+        let h22 = (ec - 2.0 * e0 + ed) / (h * h);
+        let h12 = (e(h, h)? - e(h, -h)? - e(-h, h)? + e(-h, -h)?) / (4.0 * h * h);
+        let det = h11 * h22 - h12 * h12;
+        if !(h11 > 0.0 && det > 0.0) {
+            return None;
+        }
+        let (da, db) = ((-h22 * g[0] + h12 * g[1]) / det, (h12 * g[0] - h11 * g[1]) / det);
+        // No further than half the star's mean reach in one step.
+        let len = (da * da + db * db).sqrt();
+        let cap = if len > 0.5 * reach { 0.5 * reach / len } else { 1.0 };
+        Some(p + t1 * (da * cap) + t2 * (db * cap))
     };
     // Untangle first: a vertex of a face that faces against the target at all its corners
     // moves towards its neighbours' images if that lowers the number of such faces.
@@ -233,33 +294,45 @@ pub fn smooth(
                 continue;
             }
             let v = VertexId::from_idx(vi);
-            // Uniform relaxation target in 3D (the neighbours' images), then the surface.
-            let (mut c, mut k) = (V3::zeros(), 0.0);
-            for w in source.vertex_neighbors(v) {
-                c += pos[w.idx()].coords;
-                k += 1.0;
+            // Shape-preserving relaxation target (Floater's mean-value weights of the source
+            // star applied to the neighbours' images: an isometry reproduces it), then the
+            // surface.
+            let (mut c, mut k) = (V3::zeros(), 0.0f64);
+            for h in source.outgoing(v) {
+                let l = lambda[h.idx()];
+                c += pos[source.head(h).idx()].coords * l;
+                k += l;
             }
-            if k == 0.0 {
+            if k <= 0.0 || !k.is_finite() {
                 continue;
             }
-            let goal = P3::from(c / k);
-            let Some(cur) = star_energy(v, &pos, &img_face, pos[vi], img_face[vi]) else { continue };
-            let mut step = opts.step;
+            let relaxed = P3::from(c / k);
+            // A star that is already degenerate or faces against the target accepts any valid move.
+            let cur = star_energy(v, &pos, &img_face, pos[vi], img_face[vi]).unwrap_or(f64::INFINITY);
+            // First a Newton step on the star energy in the target's tangent plane, then the
+            // relaxation target; each with step halving.
+            let newton = if cur.is_finite() { newton_goal(v, &pos, tnormal(img_face[vi])) } else { None };
             let mut moved = false;
-            for _ in 0..3 {
-                let trial = P3::from(pos[vi].coords + (goal - pos[vi]) * step);
-                let pr = loc.project(&trial);
-                if let Some(e) = star_energy(v, &pos, &img_face, pr.point, pr.face)
-                    && e < cur
-                {
-                    pos[vi] = pr.point;
-                    img_face[vi] = pr.face;
-                    map.face[vi] = pr.face;
-                    map.bary[vi] = pr.bary;
-                    moved = true;
+            for (goal, tries) in newton.map(|g| (g, 2)).into_iter().chain([(relaxed, 3)]) {
+                if moved {
                     break;
                 }
-                step *= 0.5;
+                let mut step = opts.step;
+                for _ in 0..tries {
+                    let trial = P3::from(pos[vi].coords + (goal - pos[vi]) * step);
+                    let pr = loc.project(&trial);
+                    if let Some(e) = star_energy(v, &pos, &img_face, pr.point, pr.face)
+                        && e < cur
+                    {
+                        pos[vi] = pr.point;
+                        img_face[vi] = pr.face;
+                        map.face[vi] = pr.face;
+                        map.bary[vi] = pr.bary;
+                        moved = true;
+                        break;
+                    }
+                    step *= 0.5;
+                }
             }
             if moved {
                 rep.moves += 1;

@@ -7,6 +7,7 @@
 
 pub mod complete;
 pub mod cuts;
+pub mod flip;
 pub mod greedy;
 pub mod refine;
 pub mod straighten;
@@ -76,11 +77,19 @@ pub struct LayoutOptions {
     pub rebuilds: u32,
     /// Rounds of path straightening on both meshes after the layout is built (0: none).
     pub straighten_rounds: usize,
+    /// Path flipping after the layout is built, before straightening.
+    pub flip: flip::FlipOptions,
 }
 
 impl Default for LayoutOptions {
     fn default() -> Self {
-        Self { edge_nodes: Default::default(), max_attempts: 20_000, rebuilds: 3, straighten_rounds: 1 }
+        Self {
+            edge_nodes: Default::default(),
+            max_attempts: 20_000,
+            rebuilds: 3,
+            straighten_rounds: 1,
+            flip: Default::default(),
+        }
     }
 }
 
@@ -99,6 +108,8 @@ pub struct LayoutStats {
     pub edge_nodes_min: u32,
     /// Paths shortened by straightening (both meshes).
     pub straightened: usize,
+    /// Paths flipped (the same on both meshes).
+    pub flipped: usize,
 }
 
 /// Patches from the walks of a layout: its triangular walks (all of them once the layout is

@@ -417,6 +417,46 @@ impl<'m> Tracer<'m> {
         }
     }
 
+    /// Replaces path `id` by a path from anchor `a` to `b` leaving and entering in the given
+    /// sectors (a flip). Returns the old path, or `None` (and keeps it) when no path is found.
+    ///
+    /// # Errors
+    /// `Error::Internal` if a path cannot be placed.
+    pub fn replace(
+        &mut self,
+        id: u32,
+        a: u32,
+        b: u32,
+        sector_a: Sector,
+        sector_b: Sector,
+    ) -> Result<Option<LayoutPath>> {
+        let old = self.paths[id as usize].clone();
+        let _ = self.lift(id);
+        let req = TraceRequest { a, b, sector_a: Some(sector_a), sector_b: Some(sector_b), ..Default::default() };
+        match self.trace(&req)? {
+            Some(p) => {
+                self.place(id, &p)?;
+                self.paths[id as usize] = p;
+                Ok(Some(old))
+            }
+            None => {
+                self.place(id, &old)?;
+                Ok(None)
+            }
+        }
+    }
+
+    /// Puts `old` back as path `id` (undoing [`Tracer::replace`]).
+    ///
+    /// # Errors
+    /// `Error::Internal` if the path cannot be placed.
+    pub fn restore(&mut self, id: u32, old: LayoutPath) -> Result<()> {
+        let _ = self.lift(id);
+        self.place(id, &old)?;
+        self.paths[id as usize] = old;
+        Ok(())
+    }
+
     /// The face an arc crosses and the cyclic positions of its ends, or `None` for an arc along
     /// an edge.
     pub fn arc_face(&self, u: NodeId, w: NodeId) -> Option<(FaceId, u32, u32)> {

@@ -177,12 +177,24 @@ impl FixedBoundarySystem {
     /// `Error::Numerical` if the matrix is singular or (for symmetric weights) not positive definite.
     pub fn factor(&mut self, mesh: &Mesh, weights: Weights) -> Result<FixedBoundaryFactor<'_>> {
         let w = directed_weights(mesh, weights);
-        if !weights.is_symmetric() && self.sym_lu.is_none() {
+        if !weights.is_symmetric() {
+            self.prepare_lu()?;
+        }
+        self.factor_weights(&w, weights.is_symmetric())
+    }
+
+    /// Computes the symbolic LU factorization once, for repeated non-symmetric
+    /// [`FixedBoundarySystem::factor_weights`] calls.
+    ///
+    /// # Errors
+    /// `Error::Numerical` if the symbolic analysis fails.
+    pub fn prepare_lu(&mut self) -> Result<()> {
+        if self.sym_lu.is_none() {
             let lu =
                 SymbolicLu::try_new(self.pattern()).map_err(|e| Error::Numerical(format!("symbolic LU: {e:?}")))?;
             self.sym_lu = Some(lu);
         }
-        self.factor_weights(&w, weights.is_symmetric())
+        Ok(())
     }
 
     /// Numeric factorization for explicit per-half-edge weights (e.g. reweighted by stretch).

@@ -1,0 +1,326 @@
+//! Path flipping, the second post-process of Kraevoy & Sheffer 2004 (section 4.3), applied to
+//! both methods as Kwok et al. do for their comparison: a path between two triangular patches
+//! is replaced by the other diagonal of the quadrilateral they form when the layout's patches
+//! get better shaped, i.e. the geodesic Delaunay test fails: the two angles facing the path,
+//! measured between the paths at the opposite anchors and averaged over both meshes, sum to
+//! more than π. Low-valence anchors, whose patches have corners near π, are the usual cause.
+//!
+//! A flip lifts the path on both meshes and traces the new diagonal inside the quadrilateral
+//! (leaving each opposite anchor inside its patch corner), so the rotation system changes the
+//! same way on both and the layouts stay consistent; when either trace fails both meshes keep
+//! the old path. Anchors keep at least three paths, and no second path is made between two
+//! anchors already linked.
+
+use super::tracer::{Half, Tracer};
+use super::walks::{Walk, walks};
+use crate::error::Result;
+use crate::mesh::{P3, V3};
+use crate::progress::Progress;
+use serde::{Deserialize, Serialize};
+
+/// Angles between paths are measured towards the point a quarter of each path away, which
+/// reflects the patch's shape rather than the first step's wiggle.
+const SHAPE_REACH: f64 = 0.25;
+
+/// A patch corner narrower than this (radians) is a sliver.
+const SLIVER_ANGLE: f64 = 0.25 * std::f64::consts::PI;
+
+/// Options of [`flip_paths`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct FlipOptions {
+    /// Sweeps over all paths (0 disables flipping).
+    pub rounds: usize,
+    /// Try a flip when the facing angles sum to more than π times this.
+    pub threshold: f64,
+    /// Only where the quadrilateral's angles at the path's ends stay below π times this
+    /// (convex, so the new diagonal runs inside it, away from the old ends).
+    pub max_end_angle: f64,
+    /// `voronoi`: before the target layout is built, raise source anchors to this many paths
+    /// ([`raise_valence`]; 0 disables).
+    pub min_valence: usize,
+}
+
+impl Default for FlipOptions {
+    fn default() -> Self {
+        Self { rounds: 3, threshold: 0.9, max_end_angle: 0.9, min_valence: 3 }
+    }
+}
+
+/// Output of [`flip_paths`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FlipResult {
+    pub flipped: usize,
+    /// Flips that passed the test but could not be traced on both meshes.
+    pub refused: usize,
+}
+
+/// Unit direction in which half `h` leaves its anchor, in the anchor's tangent plane (normal
+/// `n`): towards the first path point `reach` times its length away (0: the first step).
+pub(crate) fn leaving_direction(t: &Tracer, h: Half, n: V3, reach: f64) -> Option<V3> {
+    let p = &t.paths()[(h / 2) as usize];
+    let mesh = t.mesh();
+    let pts: Vec<P3> = if h.is_multiple_of(2) {
+        p.points.iter().map(|s| s.position(mesh)).collect()
+    } else {
+        p.points.iter().rev().map(|s| s.position(mesh)).collect()
+    };
+    let origin = *pts.first()?;
+    let reach = reach * p.length;
+    let mut walked = 0.0;
+    let mut target = *pts.last()?;
+    for w in pts.windows(2) {
+        walked += (w[1] - w[0]).norm();
+        if walked >= reach {
+            target = w[1];
+            break;
+        }
+    }
+    let d = target - origin;
+    let d = d - n * n.dot(&d);
+    let l = d.norm();
+    (l > 0.0).then(|| d / l)
+}
+
+/// Area-weighted vertex normal of an anchor.
+pub(crate) fn anchor_normal(t: &Tracer, a: u32) -> V3 {
+    let mesh = t.mesh();
+    let v = t.anchors()[a as usize];
+    let n: V3 = mesh.vertex_faces(v).map(|f| mesh.face_normal_raw(f)).sum();
+    let l = n.norm();
+    if l > 0.0 { n / l } else { V3::z() }
+}
+
+/// Angle of walk `w`'s corner `i`: counter-clockwise from its outgoing half to its reversed
+/// incoming half, in the tangent plane.
+fn corner_angle(t: &Tracer, w: &Walk, i: usize) -> Option<f64> {
+    let n_h = w.halves.len();
+    let a = t.half_start(w.halves[i]);
+    let n = anchor_normal(t, a);
+    let out = leaving_direction(t, w.halves[i], n, SHAPE_REACH)?;
+    let back = leaving_direction(t, w.halves[(i + n_h - 1) % n_h] ^ 1, n, SHAPE_REACH)?;
+    // The region lies to the right of its halves: clockwise from `out` to `back` seen from
+    // outside, i.e. counter-clockwise from `back` to `out`.
+    let ang = n.dot(&back.cross(&out)).atan2(back.dot(&out));
+    Some(if ang < 0.0 { ang + std::f64::consts::TAU } else { ang })
+}
+
+/// The walk containing half `h`, rotated so that it starts with `h`.
+fn walk_of(all: &[Walk], h: Half) -> Option<Walk> {
+    all.iter().find_map(|w| {
+        let i = w.halves.iter().position(|&x| x == h)?;
+        let mut halves = w.halves.clone();
+        halves.rotate_left(i);
+        Some(Walk { halves })
+    })
+}
+
+/// Sum of the two angles facing path `p` on tracer `t`, with the quadrilateral's far corners.
+/// `None` when the quadrilateral is not convex enough for the new diagonal to run inside it
+/// (its angle at either end of `p` reaches `max_end_angle`).
+fn facing_angles(t: &Tracer, p: u32, max_end_angle: f64) -> Option<(f64, u32, u32, Walk, Walk)> {
+    let all = walks(t);
+    let w1 = walk_of(&all, 2 * p)?;
+    let w2 = walk_of(&all, 2 * p + 1)?;
+    if w1.halves.len() != 3 || w2.halves.len() != 3 || w1.halves.contains(&(2 * p + 1)) {
+        return None;
+    }
+    // w1 = [a->b, b->c, c->a], w2 = [b->a, a->d, d->b]: corner 0 of w1 is a, of w2 is b.
+    let at_a = corner_angle(t, &w1, 0)? + corner_angle(t, &w2, 1)?;
+    let at_b = corner_angle(t, &w1, 1)? + corner_angle(t, &w2, 0)?;
+    if at_a >= max_end_angle || at_b >= max_end_angle {
+        return None;
+    }
+    let (c, d) = (t.half_start(w1.halves[2]), t.half_start(w2.halves[2]));
+    Some((corner_angle(t, &w1, 2)? + corner_angle(t, &w2, 2)?, c, d, w1, w2))
+}
+
+/// Flips paths on both layouts (identical path ids and rotation systems) while the test above
+/// asks for it. Returns how many paths were flipped.
+///
+/// # Errors
+/// `Cancelled`; `Error::Internal` if a lifted path cannot be restored.
+pub fn flip_paths(
+    st: &mut Tracer,
+    tt: &mut Tracer,
+    opts: &FlipOptions,
+    progress: &mut dyn Progress,
+) -> Result<FlipResult> {
+    let mut res = FlipResult::default();
+    let max_end = std::f64::consts::PI * opts.max_end_angle;
+    for _ in 0..opts.rounds {
+        let mut this_round = 0;
+        for p in 0..st.paths().len() as u32 {
+            progress.check()?;
+            let (a, b) = (st.paths()[p as usize].a, st.paths()[p as usize].b);
+            if st.rotation(a).len() <= 3 || st.rotation(b).len() <= 3 {
+                continue;
+            }
+            let (Some((s_sum, c, d, w1, w2)), Some((t_sum, c2, d2, _, _))) =
+                (facing_angles(st, p, max_end), facing_angles(tt, p, max_end))
+            else {
+                continue;
+            };
+            if c != c2 || d != d2 || c == d || [a, b].contains(&c) || [a, b].contains(&d) {
+                continue;
+            }
+            if 0.5 * (s_sum + t_sum) <= std::f64::consts::PI * opts.threshold {
+                continue;
+            }
+            let linked = st.paths().iter().any(|q| (q.a == c && q.b == d) || (q.a == d && q.b == c));
+            if linked {
+                continue;
+            }
+            // The new path c -> d leaves c inside w1's corner and reaches d inside w2's.
+            let corner = |t: &Tracer, w: &Walk| w.sector(t, 2);
+            let (sa_s, sb_s) = (corner(st, &w1), corner(st, &w2));
+            let tw1 = walk_of(&walks(tt), 2 * p);
+            let tw2 = walk_of(&walks(tt), 2 * p + 1);
+            let (Some(tw1), Some(tw2)) = (tw1, tw2) else { continue };
+            let (sa_t, sb_t) = (corner(tt, &tw1), corner(tt, &tw2));
+            let Some(old_s) = st.replace(p, c, d, sa_s, sb_s)? else {
+                res.refused += 1;
+                continue;
+            };
+            if st.paths()[p as usize].length >= old_s.length {
+                st.restore(p, old_s)?;
+                continue;
+            }
+            let Some(old_t) = tt.replace(p, c, d, sa_t, sb_t)? else {
+                st.restore(p, old_s)?;
+                res.refused += 1;
+                continue;
+            };
+            if tt.paths()[p as usize].length >= old_t.length {
+                st.restore(p, old_s)?;
+                tt.restore(p, old_t)?;
+                continue;
+            }
+            this_round += 1;
+        }
+        res.flipped += this_round;
+        if this_round == 0 {
+            break;
+        }
+    }
+    Ok(res)
+}
+
+/// Raises every anchor of a single layout that has fewer than `min` paths and a sliver corner
+/// to `min` paths by flipping a path facing it in one of its patches (the quadrilateral's
+/// other diagonal then ends at the anchor). Run on the source layout before the target is built: an
+/// anchor with two paths puts no cyclic-order constraint on the target, which may then wind
+/// its two paths the other way round (a swirl); with three the order is enforced. The far
+/// ends keep at least `min` paths. Returns the number of flips.
+///
+/// # Errors
+/// `Cancelled`; `Error::Internal` if a lifted path cannot be restored.
+pub fn raise_valence(t: &mut Tracer, min: usize, progress: &mut dyn Progress) -> Result<usize> {
+    let mut flips = 0;
+    let max_end = std::f64::consts::PI * FlipOptions::default().max_end_angle;
+    for v in 0..t.anchors().len() as u32 {
+        let mut guard = 0;
+        // Only anchors whose patches pinch to a sliver there: an anchor at the tip of a limb
+        // has two paths running down either side, and a third would wrap around the limb.
+        let pinched = walks(t).iter().any(|w| {
+            (0..w.halves.len())
+                .any(|i| t.half_start(w.halves[i]) == v && corner_angle(t, w, i).is_some_and(|a| a < SLIVER_ANGLE))
+        });
+        if !pinched {
+            continue;
+        }
+        while t.rotation(v).len() < min && guard < 4 {
+            guard += 1;
+            progress.check()?;
+            let all = walks(t);
+            let mut done = false;
+            // Each triangle with a corner at v: its side opposite v, and the triangle beyond.
+            let halves: Vec<Half> = t.rotation(v).iter().map(|&(_, h)| h).collect();
+            for h in halves {
+                let Some(w1) = walk_of(&all, h) else { continue };
+                if w1.halves.len() != 3 {
+                    continue;
+                }
+                // w1 = [v->x, x->y, y->v]; the opposite half x->y belongs to path o.
+                let opp = w1.halves[1];
+                let o = opp / 2;
+                let Some(w2) = walk_of(&all, opp ^ 1) else { continue };
+                if w2.halves.len() != 3 || w2.halves.contains(&opp) {
+                    continue;
+                }
+                let (x, y) = (t.half_start(opp), t.half_end(opp));
+                let z = t.half_start(w2.halves[2]);
+                if t.rotation(x).len() <= min || t.rotation(y).len() <= min || [v, x, y].contains(&z) {
+                    continue;
+                }
+                // Convex at x and y, so the new diagonal runs inside the quadrilateral.
+                let convex = |i1: usize, i2: usize| {
+                    matches!((corner_angle(t, &w1, i1), corner_angle(t, &w2, i2)),
+                        (Some(p), Some(q)) if p + q < max_end)
+                };
+                if !(convex(1, 1) && convex(2, 0)) {
+                    continue;
+                }
+                // New path v -> z: leaves v inside w1's corner, reaches z inside w2's.
+                let (sa, sb) = (w1.sector(t, 0), w2.sector(t, 2));
+                if t.replace(o, v, z, sa, sb)?.is_some() {
+                    flips += 1;
+                    done = true;
+                    break;
+                }
+            }
+            if !done {
+                break;
+            }
+        }
+    }
+    Ok(flips)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::greedy::greedy_layout;
+    use crate::domain::walks::is_complete;
+    use crate::domain::{LayoutOptions, patches_of};
+    use crate::mesh::{Mesh, P3, VertexId, shapes};
+    use crate::progress::NoProgress;
+
+    /// Farthest-point anchors on an icosphere stretched along x by `sx`.
+    fn stretched(sx: f64, k: usize) -> (Mesh, Vec<VertexId>) {
+        let m = shapes::icosphere(3);
+        let m = m.with_positions(m.positions().iter().map(|p| P3::new(p.x * sx, p.y, p.z)).collect()).unwrap();
+        let mut a = vec![VertexId(0)];
+        let mut d: Vec<f64> = m.positions().iter().map(|p| (p - m.positions()[0]).norm()).collect();
+        while a.len() < k {
+            let i = (0..d.len()).max_by(|&x, &y| d[x].total_cmp(&d[y])).unwrap();
+            a.push(VertexId::from_idx(i));
+            for (j, p) in m.positions().iter().enumerate() {
+                d[j] = d[j].min((p - m.positions()[i]).norm());
+            }
+        }
+        (m, a)
+    }
+
+    #[test]
+    fn flips_keep_both_layouts_complete_and_identical() {
+        let mut total = 0;
+        for (sx, k) in [(1.0, 8), (2.5, 9), (4.0, 10), (3.0, 12)] {
+            let (m, a) = stretched(sx, k);
+            // The target: the same surface scaled, so lengths and angles agree up to scale.
+            let t_mesh = m.with_positions(m.positions().iter().map(|p| P3::from(p.coords * 1.5)).collect()).unwrap();
+            let mut s = Tracer::new(&m, &a, &Default::default()).unwrap();
+            let mut t = Tracer::new(&t_mesh, &a, &Default::default()).unwrap();
+            greedy_layout(&mut s, &mut t, 2, &LayoutOptions::default(), &mut NoProgress).unwrap();
+            let before: f64 = s.paths().iter().map(|p| p.length).sum();
+            let r = flip_paths(&mut s, &mut t, &FlipOptions::default(), &mut NoProgress).unwrap();
+            total += r.flipped;
+            assert!(is_complete(&s, 2) && is_complete(&t, 2), "flips keep a triangulation");
+            assert_eq!(walks(&s), walks(&t), "the same flips on both meshes");
+            assert_eq!(patches_of(&s).len(), 2 * k - 4, "Euler: 2V - 4 triangles on a sphere");
+            let after: f64 = s.paths().iter().map(|p| p.length).sum();
+            assert!(after <= before + 1e-12, "every flip shortens a path");
+        }
+        assert!(total > 0, "a greedy layout on stretched spheres has paths to flip");
+    }
+}

@@ -20,15 +20,18 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct SmoothOptions {
-    /// Sweeps over all vertices (0 disables smoothing).
+    /// Sweeps at most (0 disables smoothing). After the first, a sweep visits only vertices
+    /// next to one whose move lowered its star energy by more than `tolerance` (relative).
     pub iterations: usize,
+    /// Relative star-energy drop below which a move does not wake its neighbours.
+    pub tolerance: f64,
     /// Fraction of the way to the relaxed position tried first (halved on rejection, twice).
     pub step: f64,
 }
 
 impl Default for SmoothOptions {
     fn default() -> Self {
-        Self { iterations: 3, step: 1.0 }
+        Self { iterations: 10, step: 1.0, tolerance: 1e-4 }
     }
 }
 
@@ -37,6 +40,8 @@ impl Default for SmoothOptions {
 pub struct SmoothReport {
     /// Points moved inside their face so that the evaluator's nearest-face rule finds it.
     pub made_visible: usize,
+    /// Moves that removed faces the evaluator counts as flipped (`visible::repair_flips`).
+    pub repaired: usize,
     pub untangled: usize,
     pub moves: usize,
     pub rejected: usize,
@@ -48,6 +53,7 @@ impl SmoothReport {
     pub fn merge(self, o: SmoothReport) -> SmoothReport {
         SmoothReport {
             made_visible: self.made_visible + o.made_visible,
+            repaired: self.repaired + o.repaired,
             untangled: self.untangled + o.untangled,
             moves: self.moves + o.moves,
             rejected: self.rejected + o.rejected,
@@ -286,59 +292,73 @@ pub fn smooth(
         }
     }
     rep.energy_before = total(&pos);
+    // One relaxation move of `vi` against the current images: the new projection and whether
+    // its star energy dropped by more than the tolerance. Reads only.
+    let try_move = |vi: usize, pos: &[P3], img_face: &[FaceId]| -> Option<(crate::topology::Projection, bool)> {
+        let v = VertexId::from_idx(vi);
+        // Shape-preserving relaxation target (Floater's mean-value weights of the source star
+        // applied to the neighbours' images: an isometry reproduces it), then the surface.
+        let (mut c, mut k) = (V3::zeros(), 0.0f64);
+        for h in source.outgoing(v) {
+            let l = lambda[h.idx()];
+            c += pos[source.head(h).idx()].coords * l;
+            k += l;
+        }
+        if k <= 0.0 || !k.is_finite() {
+            return None;
+        }
+        let relaxed = P3::from(c / k);
+        // A star that is already degenerate or faces against the target accepts any valid move.
+        let cur = star_energy(v, pos, img_face, pos[vi], img_face[vi]).unwrap_or(f64::INFINITY);
+        // First a Newton step on the star energy in the target's tangent plane, then the
+        // relaxation target; each with step halving.
+        let newton = if cur.is_finite() { newton_goal(v, pos, tnormal(img_face[vi])) } else { None };
+        for (goal, tries) in newton.map(|g| (g, 2)).into_iter().chain([(relaxed, 3)]) {
+            let mut step = opts.step;
+            for _ in 0..tries {
+                let trial = P3::from(pos[vi].coords + (goal - pos[vi]) * step);
+                let pr = loc.project_near(target, &trial, img_face[vi], 1);
+                if let Some(e) = star_energy(v, pos, img_face, pr.point, pr.face)
+                    && e < cur
+                {
+                    return Some((pr, cur - e > opts.tolerance * cur));
+                }
+                step *= 0.5;
+            }
+        }
+        None
+    };
+    // Gauss-Seidel in index order (meshes store neighbours close together, so this walks
+    // memory nearly in sequence); a sweep after the first visits only woken vertices.
+    let mut active = vec![true; n];
+    let mut next = vec![false; n];
     for it in 0..opts.iterations {
         progress.check()?;
         progress.report("smooth", it as f64 / opts.iterations as f64);
         for vi in 0..n {
-            if is_fixed[vi] {
+            if is_fixed[vi] || !active[vi] {
                 continue;
             }
-            let v = VertexId::from_idx(vi);
-            // Shape-preserving relaxation target (Floater's mean-value weights of the source
-            // star applied to the neighbours' images: an isometry reproduces it), then the
-            // surface.
-            let (mut c, mut k) = (V3::zeros(), 0.0f64);
-            for h in source.outgoing(v) {
-                let l = lambda[h.idx()];
-                c += pos[source.head(h).idx()].coords * l;
-                k += l;
-            }
-            if k <= 0.0 || !k.is_finite() {
-                continue;
-            }
-            let relaxed = P3::from(c / k);
-            // A star that is already degenerate or faces against the target accepts any valid move.
-            let cur = star_energy(v, &pos, &img_face, pos[vi], img_face[vi]).unwrap_or(f64::INFINITY);
-            // First a Newton step on the star energy in the target's tangent plane, then the
-            // relaxation target; each with step halving.
-            let newton = if cur.is_finite() { newton_goal(v, &pos, tnormal(img_face[vi])) } else { None };
-            let mut moved = false;
-            for (goal, tries) in newton.map(|g| (g, 2)).into_iter().chain([(relaxed, 3)]) {
-                if moved {
-                    break;
-                }
-                let mut step = opts.step;
-                for _ in 0..tries {
-                    let trial = P3::from(pos[vi].coords + (goal - pos[vi]) * step);
-                    let pr = loc.project(&trial);
-                    if let Some(e) = star_energy(v, &pos, &img_face, pr.point, pr.face)
-                        && e < cur
-                    {
-                        pos[vi] = pr.point;
-                        img_face[vi] = pr.face;
-                        map.face[vi] = pr.face;
-                        map.bary[vi] = pr.bary;
-                        moved = true;
-                        break;
-                    }
-                    step *= 0.5;
-                }
-            }
-            if moved {
-                rep.moves += 1;
-            } else {
+            let Some((pr, wake)) = try_move(vi, &pos, &img_face) else {
                 rep.rejected += 1;
+                continue;
+            };
+            if wake {
+                next[vi] = true;
+                for w in source.vertex_neighbors(VertexId::from_idx(vi)) {
+                    next[w.idx()] = true;
+                }
             }
+            pos[vi] = pr.point;
+            img_face[vi] = pr.face;
+            map.face[vi] = pr.face;
+            map.bary[vi] = pr.bary;
+            rep.moves += 1;
+        }
+        std::mem::swap(&mut active, &mut next);
+        next.fill(false);
+        if !active.iter().any(|&a| a) {
+            break;
         }
     }
     rep.energy_after = total(&pos);

@@ -60,3 +60,143 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
     }
     Ok(moved)
 }
+
+/// Faces of `v`'s star that the evaluator counts as flipped, were `v`'s image at `p` (nearest
+/// target face `pf`) and every other vertex `w` at `pos[w]` (nearest face `near[w]`): normal
+/// against the target's at the faces nearest to all three corners and to the centroid.
+fn evaluator_flips_in_star(
+    source: &Mesh,
+    tn: &[crate::mesh::V3],
+    index: &SurfaceIndex,
+    v: VertexId,
+    (p, pf): (P3, crate::FaceId),
+    pos: &[P3],
+    near: &[crate::FaceId],
+) -> usize {
+    source
+        .vertex_faces(v)
+        .filter(|&f| {
+            let tri = source.face(f);
+            let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
+            let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+            let c = crate::metrics::face_centroid(m);
+            let mut under = tri.map(|w| if w == v { pf } else { near[w.idx()] }).to_vec();
+            under.push(index.query(&c).face);
+            under.iter().all(|g| nm.dot(&tn[g.idx()]) < 0.0)
+        })
+        .count()
+}
+
+/// Removes faces that the evaluator would count as flipped although smoothing's own test (the
+/// faces the corners were projected on) passed them: points on edges and creases, where the
+/// evaluator's nearest face is a neighbour of ours. Each free corner of such a face tries moves
+/// towards its neighbours' images (and half-way to each), projected onto the target, and takes
+/// the first that lowers the evaluator-counted flips of its star and stays visible. Returns
+/// the number of moves.
+///
+/// # Errors
+/// `Error::Internal` if an index cannot be built.
+pub fn repair_flips(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &[VertexId]) -> crate::Result<usize> {
+    let n = source.n_vertices();
+    let mut pos: Vec<P3> = (0..n).map(|v| map.position(VertexId::from_idx(v), target)).collect();
+    let tn: Vec<crate::mesh::V3> = (0..target.n_faces())
+        .map(|f| {
+            let x = target.face_normal_raw(crate::FaceId::from_idx(f));
+            x / x.norm().max(crate::tol::TINY)
+        })
+        .collect();
+    // Cheap screen: faces against the target at one corner's own face at least.
+    let suspects: Vec<crate::FaceId> = (0..source.n_faces())
+        .map(crate::FaceId::from_idx)
+        .filter(|&f| {
+            let tri = source.face(f);
+            let m = tri.map(|w| pos[w.idx()]);
+            let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+            tri.iter().any(|w| nm.dot(&tn[map.face[w.idx()].idx()]) < 0.0)
+        })
+        .collect();
+    if suspects.is_empty() {
+        return Ok(0);
+    }
+    let index = SurfaceIndex::new(target)?;
+    let tol = 1e-9 * target.bbox_diagonal();
+    let mut near: Vec<crate::FaceId> = map.face.clone();
+    for &f in &suspects {
+        for w in source.face(f) {
+            near[w.idx()] = index.query(&pos[w.idx()]).face;
+        }
+    }
+    let mut is_fixed = vec![false; n];
+    for v in fixed {
+        is_fixed[v.idx()] = true;
+    }
+    let mut loc: Option<crate::topology::Locator> = None;
+    let mut moves = 0;
+    for f in suspects {
+        for v in source.face(f) {
+            if is_fixed[v.idx()] || source.is_boundary_vertex(v) {
+                continue;
+            }
+            let here = (pos[v.idx()], near[v.idx()]);
+            let cur = evaluator_flips_in_star(source, &tn, &index, v, here, &pos, &near);
+            if cur == 0 {
+                continue;
+            }
+            let nbrs: Vec<VertexId> = source.vertex_neighbors(v).collect();
+            let mean = nbrs.iter().fold(crate::mesh::V3::zeros(), |a, w| a + pos[w.idx()].coords) / nbrs.len() as f64;
+            let mut cands: Vec<P3> =
+                [1.0, 0.5, 0.25].iter().map(|&t| P3::from(pos[v.idx()].coords * (1.0 - t) + mean * t)).collect();
+            cands.extend(nbrs.iter().map(|w| P3::from((pos[v.idx()].coords + pos[w.idx()].coords) * 0.5)));
+            let l = match &loc {
+                Some(l) => l,
+                None => loc.insert(crate::topology::Locator::new(target)?),
+            };
+            for c in cands {
+                let pr = l.project(&c);
+                let q = index.query(&pr.point);
+                if q.distance > tol {
+                    continue;
+                }
+                if evaluator_flips_in_star(source, &tn, &index, v, (pr.point, q.face), &pos, &near) < cur {
+                    pos[v.idx()] = pr.point;
+                    near[v.idx()] = q.face;
+                    map.face[v.idx()] = pr.face;
+                    map.bary[v.idx()] = pr.bary;
+                    moves += 1;
+                    break;
+                }
+            }
+        }
+    }
+    Ok(moves)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+    use crate::metrics::{MetricsOptions, evaluate_map};
+
+    #[test]
+    fn a_folded_vertex_is_unfolded_by_the_evaluator_s_rule() {
+        let s = shapes::icosphere(3);
+        // Push vertex 0's image past a neighbour: its star folds over.
+        let v = VertexId(0);
+        let w = s.vertex_neighbors(v).next().unwrap();
+        let mut pos = s.positions().to_vec();
+        let p = P3::from(pos[w.idx()].coords * 2.0 - pos[v.idx()].coords);
+        pos[v.idx()] = P3::from(p.coords / p.coords.norm());
+        let mut map = SurfaceMap::from_positions(&pos, &s, None).unwrap();
+        let flips = |map: &SurfaceMap| {
+            let m = map.embed(&s, &s).unwrap();
+            evaluate_map(&s, &s, &m, None, None, &MetricsOptions { samples: 100, seeds: (1, 2) }).unwrap().flipped_faces
+        };
+        assert!(flips(&map) > 0, "the test starts folded");
+        let moves = repair_flips(&s, &s, &mut map, &[]).unwrap();
+        assert!(moves > 0);
+        assert_eq!(flips(&map), 0);
+        let m = map.embed(&s, &s).unwrap();
+        let off = evaluate_map(&s, &s, &m, None, None, &MetricsOptions { samples: 100, seeds: (1, 2) }).unwrap();
+        assert!(off.off_surface_max < 1e-9);
+    }
+}

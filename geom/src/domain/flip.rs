@@ -39,11 +39,13 @@ pub struct FlipOptions {
     /// `voronoi`: before the target layout is built, raise source anchors to this many paths
     /// ([`raise_valence`]; 0 disables).
     pub min_valence: usize,
+    /// Also require the new diagonal to be shorter than the old path on both meshes.
+    pub shorter_only: bool,
 }
 
 impl Default for FlipOptions {
     fn default() -> Self {
-        Self { rounds: 3, threshold: 0.9, max_end_angle: 0.9, min_valence: 3 }
+        Self { rounds: 3, threshold: 0.9, max_end_angle: 0.9, min_valence: 3, shorter_only: true }
     }
 }
 
@@ -182,7 +184,7 @@ pub fn flip_paths(
                 res.refused += 1;
                 continue;
             };
-            if st.paths()[p as usize].length >= old_s.length {
+            if opts.shorter_only && st.paths()[p as usize].length >= old_s.length {
                 st.restore(p, old_s)?;
                 continue;
             }
@@ -191,7 +193,7 @@ pub fn flip_paths(
                 res.refused += 1;
                 continue;
             };
-            if tt.paths()[p as usize].length >= old_t.length {
+            if opts.shorter_only && tt.paths()[p as usize].length >= old_t.length {
                 st.restore(p, old_s)?;
                 tt.restore(p, old_t)?;
                 continue;

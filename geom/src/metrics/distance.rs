@@ -63,7 +63,7 @@ pub fn hausdorff(a: &Mesh, b: &Mesh, n: usize, seeds: (u64, u64)) -> Result<Haus
 }
 
 /// Indices of `pts` sorted along a Z-order (Morton) curve of their bounding box.
-fn morton_order(pts: &[P3]) -> Vec<usize> {
+pub(crate) fn morton_order(pts: &[P3]) -> Vec<usize> {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in pts {

@@ -14,13 +14,14 @@ pub fn flipped_faces(mapped: &Mesh, target: &Mesh, index: &SurfaceIndex, vertex_
             n / n.norm().max(crate::tol::TINY)
         })
         .collect();
+    let cents: Vec<_> = (0..mapped.n_faces()).map(|f| centroid(mapped.face_points(FaceId::from_idx(f)))).collect();
+    let at_centroid = index.query_all(&cents);
     let mut count = 0;
     for (fi, f) in mapped.faces().iter().enumerate() {
         let fid = FaceId::from_idx(fi);
         let nm = mapped.face_normal_raw(fid);
-        let c = centroid(mapped.face_points(fid));
         let under = [
-            index.query(&c).face,
+            at_centroid[fi].face,
             vertex_nearest[f[0].idx()].face,
             vertex_nearest[f[1].idx()].face,
             vertex_nearest[f[2].idx()].face,

@@ -14,6 +14,8 @@ pub use distance::{HausdorffResult, hausdorff, sample_surface};
 pub use distortion::{Distortion, distortion};
 pub use flips::flipped_faces;
 pub use numpy_rng::NumpyRng;
+pub(crate) use surface_index::centroid as face_centroid;
+pub(crate) use surface_index::closest_point_on_triangle as closest_point;
 pub use surface_index::{Nearest, SurfaceIndex};
 
 use crate::error::{InputError, Result};
@@ -87,7 +89,7 @@ pub fn evaluate_map(
     }
     let diag = target.bbox_diagonal();
     let index = SurfaceIndex::new(target)?;
-    let proj: Vec<Nearest> = mapped.positions().iter().map(|p| index.query(p)).collect();
+    let proj: Vec<Nearest> = index.query_all(mapped.positions());
     let n = proj.len().max(1) as f64;
     let off_max = proj.iter().map(|p| p.distance).fold(0.0, f64::max);
     let dists: Vec<f64> = proj.iter().map(|p| p.distance).collect();

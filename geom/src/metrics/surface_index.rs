@@ -8,7 +8,11 @@
 use crate::error::{Error, Result};
 use crate::mesh::{FaceId, Mesh, P3, V3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rayon::prelude::*;
 use std::num::NonZeroUsize;
+
+/// Consecutive (Morton-ordered) queries handled by one task.
+const SEARCH_RUN: usize = 8192;
 
 /// Candidates per query, as in the evaluator.
 pub const CANDIDATES: usize = 24;
@@ -108,14 +112,44 @@ impl<'m> SurfaceIndex<'m> {
     }
 
     /// The distances of [`SurfaceIndex::query`] for `pts`, visited in `order` (nearby points in
-    /// turn, e.g. Morton order). Each search is bounded by the previous point's k-th candidate
-    /// distance plus the step between the points: by the triangle inequality at least k
-    /// centroids lie inside, so the candidate set, and so the distance, is the same as an
-    /// unbounded search. One scratch buffer serves every search. Only the distance is returned,
-    /// which is the minimum over the candidate set whatever its order, so the searches skip
-    /// sorting.
+    /// turn, e.g. Morton order). Only the distance is returned, which is the minimum over the
+    /// candidate set whatever its order, so the searches skip sorting.
     pub fn distances_in_order(&self, pts: &[P3], order: &[usize]) -> Vec<f64> {
         let mut out = vec![0.0; pts.len()];
+        for (i, n) in self.search_chunks(pts, order, false) {
+            out[i] = n.distance;
+        }
+        out
+    }
+
+    /// [`SurfaceIndex::query`] for every point (face and point included, ties resolved in the
+    /// candidates' distance order as the evaluator does), visited in Morton order.
+    pub fn query_all(&self, pts: &[P3]) -> Vec<Nearest> {
+        let mut out = vec![Nearest { distance: f64::INFINITY, face: FaceId(0), point: P3::origin() }; pts.len()];
+        for (i, n) in self.search_chunks(pts, &super::distance::morton_order(pts), true) {
+            out[i] = n;
+        }
+        out
+    }
+
+    /// The searches of `order`, in runs of consecutive points spread over the thread pool
+    /// (each run with its own scratch and hint; answers do not depend on the split).
+    fn search_chunks(&self, pts: &[P3], order: &[usize], sorted: bool) -> Vec<(usize, Nearest)> {
+        order
+            .par_chunks(SEARCH_RUN)
+            .flat_map_iter(|run| {
+                let mut out = Vec::with_capacity(run.len());
+                self.search_in_order(pts, run, sorted, |i, n| out.push((i, n)));
+                out
+            })
+            .collect()
+    }
+
+    /// Runs the candidate search for `pts` in `order`, handing each answer to `put`. Each
+    /// search is bounded by the previous point's k-th candidate distance plus the step between
+    /// the points: by the triangle inequality at least k centroids lie inside, so the candidate
+    /// set is that of an unbounded search. One scratch buffer serves every search.
+    fn search_in_order(&self, pts: &[P3], order: &[usize], sorted: bool, mut put: impl FnMut(usize, Nearest)) {
         let mut scratch = self.tree.create_scratch::<SquaredEuclidean<f64>>();
         let mut hint: Option<(P3, f64)> = None;
         for &i in order {
@@ -123,35 +157,32 @@ impl<'m> SurfaceIndex<'m> {
             let q = [p.x, p.y, p.z];
             let bounded = hint.and_then(|(prev, dk)| {
                 let r = (dk + (p - prev).norm()) * (1.0 + 1e-9);
-                let c = self
-                    .tree
-                    .query(&q)
-                    .nearest_n::<SquaredEuclidean<f64>>(self.k)
-                    .within(r * r)
-                    .unsorted()
-                    .with_scratch(&mut scratch)
-                    .execute();
+                let query = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).within(r * r);
+                let c = if sorted {
+                    query.with_scratch(&mut scratch).execute()
+                } else {
+                    query.unsorted().with_scratch(&mut scratch).execute()
+                };
                 // Always k by the triangle inequality; the fallback only guards degenerate input.
                 (c.len() == self.k.get()).then_some(c)
             });
             let cand = match bounded {
                 Some(c) => c,
-                None => self
-                    .tree
-                    .query(&q)
-                    .nearest_n::<SquaredEuclidean<f64>>(self.k)
-                    .unsorted()
-                    .with_scratch(&mut scratch)
-                    .execute(),
+                None => {
+                    let query = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k);
+                    if sorted {
+                        query.with_scratch(&mut scratch).execute()
+                    } else {
+                        query.unsorted().with_scratch(&mut scratch).execute()
+                    }
+                }
             };
-            // Unsorted: the k-th distance is the largest.
             let dk = cand.iter().map(|n| n.distance).fold(f64::NEG_INFINITY, f64::max);
             if dk.is_finite() {
                 hint = Some((*p, dk.sqrt()));
             }
-            out[i] = self.best_of(p, cand.iter().map(|n| (n.item, n.distance))).distance;
+            put(i, self.best_of(p, cand.iter().map(|n| (n.item, n.distance))));
         }
-        out
     }
 
     /// Nearest point among the candidate faces.

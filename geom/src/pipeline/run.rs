@@ -160,12 +160,14 @@ pub fn run_map(
         || {
             let (mut m, r) = smooth::smooth(target, source, t2s, &ta, &o.smoothing, &mut crate::progress::NoProgress)?;
             let v = crate::crossparam::visible::make_visible(target, source, &mut m, &ta)?;
-            Ok::<_, Error>((m, r, v))
+            let repaired = crate::crossparam::visible::repair_flips(target, source, &mut m, &ta)?;
+            Ok::<_, Error>((m, smooth::SmoothReport { repaired, ..r }, v))
         },
         || {
             let (mut m, r) = smooth::smooth(source, target, s2t, &sa, &o.smoothing, progress)?;
             let v = crate::crossparam::visible::make_visible(source, target, &mut m, &sa)?;
-            Ok::<_, Error>((m, r, v))
+            let repaired = crate::crossparam::visible::repair_flips(source, target, &mut m, &sa)?;
+            Ok::<_, Error>((m, smooth::SmoothReport { repaired, ..r }, v))
         },
     )?;
     let ((s2t, r1, v1), (t2s, r2, v2)) = (a?, b?);

@@ -41,6 +41,56 @@ impl Locator {
         let point = P3::new(proj.point.x, proj.point.y, proj.point.z);
         Projection { face: FaceId(fid), bary, point, distance: (point - p).norm() }
     }
+
+    /// The closest point to `p` among the faces within `rings` face-rings of `start` (a point
+    /// that moved a little from `start`): a local search that stays on the same sheet of the
+    /// surface. Falls back to the BVH when the best face is on the outermost ring (the true
+    /// closest point may lie beyond).
+    pub fn project_near(&self, mesh: &Mesh, p: &P3, start: FaceId, rings: usize) -> Projection {
+        let mut faces = vec![start];
+        let mut ring_start = 0;
+        for _ in 0..rings {
+            let ring_end = faces.len();
+            for i in ring_start..ring_end {
+                for g in mesh.face_neighbors(faces[i]) {
+                    if !faces.contains(&g) {
+                        faces.push(g);
+                    }
+                }
+            }
+            ring_start = ring_end;
+        }
+        let mut best: Option<(f64, usize, P3)> = None;
+        for (i, &f) in faces.iter().enumerate() {
+            let [a, b, c] = mesh.face_points(f);
+            let q = crate::metrics::closest_point(*p, a, b, c);
+            let d = (q - p).norm_squared();
+            if best.is_none_or(|(bd, _, _)| d < bd) {
+                best = Some((d, i, q));
+            }
+        }
+        match best {
+            Some((d, i, q)) if i < ring_start || rings == 0 => {
+                let f = faces[i];
+                Projection { face: f, bary: barycentric(mesh.face_points(f), q), point: q, distance: d.sqrt() }
+            }
+            _ => self.project(p),
+        }
+    }
+}
+
+/// Barycentric coordinates of `q` (on or near triangle `t`), clamped to the triangle.
+fn barycentric(t: [P3; 3], q: P3) -> [f64; 3] {
+    let (e1, e2, d) = (t[1] - t[0], t[2] - t[0], q - t[0]);
+    let (a, b, c) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
+    let (r1, r2) = (e1.dot(&d), e2.dot(&d));
+    let det = a * c - b * b;
+    if det <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let v = ((c * r1 - b * r2) / det).clamp(0.0, 1.0);
+    let w = ((a * r2 - b * r1) / det).clamp(0.0, 1.0 - v);
+    [1.0 - v - w, v, w]
 }
 
 #[cfg(test)]

@@ -119,8 +119,11 @@ def cases(tmp):
         ("armadillo bent", "armadillo.obj", "bend", 45),
         ("armadillo/subdivided", "armadillo.obj", "subdivided", 45),
         ("torus twisted (g1)", "torus.obj", "twist", 24),
+        ("torus bent (g1)", "torus.obj", "bend", 24),
+        ("rocker arm bent (g1)", "rocker_arm/rocker-arm.obj", "bend", 24),
         ("kitten twisted (g1)", "kitten.nf20k.off", "twist", 24),
         ("eight bent (g2)", "eight.off", "bend", 24),
+        ("eight_lowres twisted (g2)", "eight_lowres.off", "twist", 24),
     ]:
         tag = name.split()[0].replace("/", "_") + "_" + kind
         s, t, a, gt = same_shape(tmp, tag, os.path.join(M, path), kind, k)

@@ -153,7 +153,9 @@ fn flatten_patch(
         (fixed.clone(), 0.0)
     } else {
         let mut sys = FixedBoundarySystem::new(&local, &lp)?;
-        if !opts.weights.is_symmetric() {
+        if opts.weights.is_symmetric() {
+            sys.prepare_cholesky()?;
+        } else {
             sys.prepare_lu()?;
         }
         let w = directed_weights(&local, opts.weights);

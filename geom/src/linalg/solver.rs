@@ -117,7 +117,7 @@ impl FixedBoundarySystem {
             }
         }
         let diag_slot = (0..n).map(|i| find(i, i)).collect();
-        let mut sys = FixedBoundarySystem {
+        let sys = FixedBoundarySystem {
             n_vertices: nv,
             free_index,
             free,
@@ -130,7 +130,6 @@ impl FixedBoundarySystem {
             sym_lu: None,
             ends,
         };
-        sys.sym_llt = Some(sys.symbolic_cholesky()?);
         Ok(sys)
     }
 
@@ -177,10 +176,24 @@ impl FixedBoundarySystem {
     /// `Error::Numerical` if the matrix is singular or (for symmetric weights) not positive definite.
     pub fn factor(&mut self, mesh: &Mesh, weights: Weights) -> Result<FixedBoundaryFactor<'_>> {
         let w = directed_weights(mesh, weights);
-        if !weights.is_symmetric() {
+        if weights.is_symmetric() {
+            self.prepare_cholesky()?;
+        } else {
             self.prepare_lu()?;
         }
         self.factor_weights(&w, weights.is_symmetric())
+    }
+
+    /// Computes the symbolic Cholesky factorization once (AMD ordering), for symmetric
+    /// [`FixedBoundarySystem::factor_weights`] calls.
+    ///
+    /// # Errors
+    /// `Error::Numerical` if the symbolic analysis fails.
+    pub fn prepare_cholesky(&mut self) -> Result<()> {
+        if self.sym_llt.is_none() {
+            self.sym_llt = Some(self.symbolic_cholesky()?);
+        }
+        Ok(())
     }
 
     /// Computes the symbolic LU factorization once, for repeated non-symmetric
@@ -231,7 +244,10 @@ impl FixedBoundarySystem {
         let mat = SparseColMatRef::new(self.pattern(), &values);
         let (mut llt, mut lu) = (None, None);
         if symmetric {
-            let sym = self.sym_llt.as_ref().ok_or_else(|| Error::Internal("missing symbolic Cholesky".into()))?;
+            let sym = self
+                .sym_llt
+                .as_ref()
+                .ok_or_else(|| Error::Internal("symmetric factorization without prepare_cholesky()".into()))?;
             let mut l_values = vec![0.0; sym.len_val()];
             let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
                 .map_err(|e| Error::Numerical(format!("Cholesky workspace: {e:?}")))?;

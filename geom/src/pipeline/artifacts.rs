@@ -74,29 +74,23 @@ pub fn map_artifacts(
     let pj: Vec<_> = patches.iter().map(|p| json!({"corners": p.corners, "paths": p.sides.map(|h| h / 2)})).collect();
     let layout = json!({ "anchors": anchors, "paths": paths, "patches": pj });
     let layout = serde_json::to_vec_pretty(&layout).map_err(|e| Error::Internal(e.to_string()))?;
+    // The large encodings are independent: build them on the thread pool.
+    let ((obj_t, obj_s), ((csv_st, csv_ts), (ply_s, ply_t))) = rayon::join(
+        || rayon::join(|| io::write(on_target, Format::Obj), || io::write(on_source, Format::Obj)),
+        || {
+            rayon::join(
+                || rayon::join(|| result.source_to_target.to_csv(), || result.target_to_source.to_csv()),
+                || rayon::join(|| layout_ply(rs), || layout_ply(rt)),
+            )
+        },
+    );
     Ok(vec![
-        Artifact {
-            name: "source_on_target.obj".into(),
-            content_type: "model/obj",
-            bytes: io::write(on_target, Format::Obj),
-        },
-        Artifact {
-            name: "target_on_source.obj".into(),
-            content_type: "model/obj",
-            bytes: io::write(on_source, Format::Obj),
-        },
-        Artifact {
-            name: "source_to_target.csv".into(),
-            content_type: "text/csv",
-            bytes: result.source_to_target.to_csv().into_bytes(),
-        },
-        Artifact {
-            name: "target_to_source.csv".into(),
-            content_type: "text/csv",
-            bytes: result.target_to_source.to_csv().into_bytes(),
-        },
+        Artifact { name: "source_on_target.obj".into(), content_type: "model/obj", bytes: obj_t },
+        Artifact { name: "target_on_source.obj".into(), content_type: "model/obj", bytes: obj_s },
+        Artifact { name: "source_to_target.csv".into(), content_type: "text/csv", bytes: csv_st.into_bytes() },
+        Artifact { name: "target_to_source.csv".into(), content_type: "text/csv", bytes: csv_ts.into_bytes() },
         Artifact { name: "layout.json".into(), content_type: "application/json", bytes: layout },
-        Artifact { name: "layout_source.ply".into(), content_type: "application/vnd.ply", bytes: layout_ply(rs) },
-        Artifact { name: "layout_target.ply".into(), content_type: "application/vnd.ply", bytes: layout_ply(rt) },
+        Artifact { name: "layout_source.ply".into(), content_type: "application/vnd.ply", bytes: ply_s },
+        Artifact { name: "layout_target.ply".into(), content_type: "application/vnd.ply", bytes: ply_t },
     ])
 }

@@ -155,36 +155,33 @@ pub fn run_map(
         both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
     clock.lap("compose");
     progress.check()?;
-    // The two directions are independent: smooth them on two threads.
-    let (a, b) = both(
-        || {
-            let (mut m, r) = smooth::smooth(target, source, t2s, &ta, &o.smoothing, &mut crate::progress::NoProgress)?;
-            let v = crate::crossparam::visible::make_visible(target, source, &mut m, &ta)?;
-            let repaired = crate::crossparam::visible::repair_flips(target, source, &mut m, &ta)?;
-            Ok::<_, Error>((m, smooth::SmoothReport { repaired, ..r }, v))
-        },
-        || {
-            let (mut m, r) = smooth::smooth(source, target, s2t, &sa, &o.smoothing, progress)?;
-            let v = crate::crossparam::visible::make_visible(source, target, &mut m, &sa)?;
-            let repaired = crate::crossparam::visible::repair_flips(source, target, &mut m, &sa)?;
-            Ok::<_, Error>((m, smooth::SmoothReport { repaired, ..r }, v))
-        },
-    )?;
-    let ((s2t, r1, v1), (t2s, r2, v2)) = (a?, b?);
-    let visible = v1 + v2;
-    clock.lap("smooth");
-    progress.check()?;
-    let result = MapResult { source_to_target: s2t, target_to_source: t2s };
-    let (on_target, on_source) =
-        both(|| result.target_to_source.embed(target, source), || result.source_to_target.embed(source, target))?;
-    let (on_target, on_source) = (on_target?, on_source?);
-    progress.report("metrics", 0.0);
+    // The two directions are independent from here on: each thread smooths its map, makes it
+    // visible to the evaluator's rules, embeds it and measures it, so the lighter direction's
+    // metrics overlap the heavier direction's smoothing.
     let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
-    let (m1, m2) = both(
-        || evaluate_map(target, source, &on_source, Some(&rev), None, &mo),
-        || evaluate_map(source, target, &on_target, Some(&pairs), None, &mo),
+    let finish = |from: &Mesh,
+                  to: &Mesh,
+                  map: SurfaceMap,
+                  fixed: &[VertexId],
+                  anchors: &[(VertexId, VertexId)],
+                  progress: &mut dyn Progress,
+                  smoothed: &mut dyn FnMut()| {
+        let (mut m, r) = smooth::smooth(from, to, map, fixed, &o.smoothing, progress)?;
+        let v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
+        let repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
+        smoothed();
+        progress.check()?;
+        progress.report("metrics", 0.0);
+        let embedded = m.embed(from, to)?;
+        let metrics = evaluate_map(from, to, &embedded, Some(anchors), None, &mo)?;
+        Ok::<_, Error>((m, smooth::SmoothReport { repaired, made_visible: v, ..r }, embedded, metrics))
+    };
+    let (a, b) = both(
+        || finish(target, source, t2s, &ta, &rev, &mut crate::progress::NoProgress, &mut || {}),
+        || finish(source, target, s2t, &sa, &pairs, progress, &mut || clock.lap("smooth")),
     )?;
-    let (m1, m2) = (m1?, m2?);
+    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = (a?, b?);
+    let result = MapResult { source_to_target: s2t, target_to_source: t2s };
     clock.lap("metrics");
     progress.check()?;
     let mut report = MapReport {
@@ -197,7 +194,7 @@ pub fn run_map(
         source_to_target: m1,
         target_to_source: m2,
         timings_ms: Vec::new(),
-        smoothing: smooth::SmoothReport { made_visible: visible, ..r1.merge(r2) },
+        smoothing: r1.merge(r2),
     };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, &result, &on_target, &on_source)?;
     clock.lap("artifacts");

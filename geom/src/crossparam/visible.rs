@@ -87,12 +87,17 @@ fn evaluator_flips_in_star(
         .count()
 }
 
+/// Passes of [`repair_flips`] at most.
+const REPAIR_PASSES: usize = 8;
+
 /// Removes faces that the evaluator would count as flipped although smoothing's own test (the
 /// faces the corners were projected on) passed them: points on edges and creases, where the
-/// evaluator's nearest face is a neighbour of ours. Each free corner of such a face tries moves
-/// towards its neighbours' images (and half-way to each), projected onto the target, and takes
-/// the first that lowers the evaluator-counted flips of its star and stays visible. Returns
-/// the number of moves.
+/// evaluator's nearest face is a neighbour of ours, and folds that smoothing's one-vertex moves
+/// could not undo. Each free corner of such a face tries moves towards (and past) its
+/// neighbours' images, half-way to each, and to its mapped faces' centroids, projected onto the
+/// target, and takes the one that most lowers the evaluator-counted flips of its star while
+/// staying visible; passes repeat over the faces around moved vertices. Returns the number of
+/// moves.
 ///
 /// # Errors
 /// `Error::Internal` if an index cannot be built.
@@ -132,38 +137,70 @@ pub fn repair_flips(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
     }
     let mut loc: Option<crate::topology::Locator> = None;
     let mut moves = 0;
-    for f in suspects {
-        for v in source.face(f) {
-            if is_fixed[v.idx()] || source.is_boundary_vertex(v) {
-                continue;
-            }
-            let here = (pos[v.idx()], near[v.idx()]);
-            let cur = evaluator_flips_in_star(source, &tn, &index, v, here, &pos, &near);
-            if cur == 0 {
-                continue;
-            }
-            let nbrs: Vec<VertexId> = source.vertex_neighbors(v).collect();
-            let mean = nbrs.iter().fold(crate::mesh::V3::zeros(), |a, w| a + pos[w.idx()].coords) / nbrs.len() as f64;
-            let mut cands: Vec<P3> =
-                [1.0, 0.5, 0.25].iter().map(|&t| P3::from(pos[v.idx()].coords * (1.0 - t) + mean * t)).collect();
-            cands.extend(nbrs.iter().map(|w| P3::from((pos[v.idx()].coords + pos[w.idx()].coords) * 0.5)));
-            let l = match &loc {
-                Some(l) => l,
-                None => loc.insert(crate::topology::Locator::new(target)?),
-            };
-            for c in cands {
-                let pr = l.project(&c);
-                let q = index.query(&pr.point);
-                if q.distance > tol {
+    let mut suspects = suspects;
+    // A fold can need several vertices to move in turn: passes over the faces still flipped
+    // (and those around the vertices moved), until a pass changes nothing.
+    for _ in 0..REPAIR_PASSES {
+        let mut touched: Vec<VertexId> = Vec::new();
+        for &f in &suspects {
+            for v in source.face(f) {
+                if is_fixed[v.idx()] || source.is_boundary_vertex(v) {
                     continue;
                 }
-                if evaluator_flips_in_star(source, &tn, &index, v, (pr.point, q.face), &pos, &near) < cur {
+                let here = (pos[v.idx()], near[v.idx()]);
+                let cur = evaluator_flips_in_star(source, &tn, &index, v, here, &pos, &near);
+                if cur == 0 {
+                    continue;
+                }
+                let nbrs: Vec<VertexId> = source.vertex_neighbors(v).collect();
+                let mean =
+                    nbrs.iter().fold(crate::mesh::V3::zeros(), |a, w| a + pos[w.idx()].coords) / nbrs.len() as f64;
+                let p0 = pos[v.idx()].coords;
+                // Towards (and past) the neighbours' mean, half-way to each neighbour, and to
+                // the centroids of the star's mapped faces.
+                let mut cands: Vec<P3> =
+                    [1.0, 0.5, 0.25, 1.5, 2.0].iter().map(|&t| P3::from(p0 * (1.0 - t) + mean * t)).collect();
+                cands.extend(nbrs.iter().map(|w| P3::from((p0 + pos[w.idx()].coords) * 0.5)));
+                cands.extend(source.vertex_faces(v).map(|g| {
+                    let t = source.face(g);
+                    P3::from(t.iter().map(|w| pos[w.idx()].coords).sum::<crate::mesh::V3>() / 3.0)
+                }));
+                let l = match &loc {
+                    Some(l) => l,
+                    None => loc.insert(crate::topology::Locator::new(target)?),
+                };
+                let mut best: Option<(usize, crate::topology::Projection, crate::FaceId)> = None;
+                for c in cands {
+                    let pr = l.project(&c);
+                    let q = index.query(&pr.point);
+                    if q.distance > tol {
+                        continue;
+                    }
+                    let k = evaluator_flips_in_star(source, &tn, &index, v, (pr.point, q.face), &pos, &near);
+                    if k < cur && best.as_ref().is_none_or(|b| k < b.0) {
+                        best = Some((k, pr, q.face));
+                    }
+                }
+                if let Some((_, pr, nf)) = best {
                     pos[v.idx()] = pr.point;
-                    near[v.idx()] = q.face;
+                    near[v.idx()] = nf;
                     map.face[v.idx()] = pr.face;
                     map.bary[v.idx()] = pr.bary;
                     moves += 1;
-                    break;
+                    touched.push(v);
+                }
+            }
+        }
+        if touched.is_empty() {
+            break;
+        }
+        for v in touched {
+            for g in source.vertex_faces(v) {
+                for w in source.face(g) {
+                    near[w.idx()] = index.query(&pos[w.idx()]).face;
+                }
+                if !suspects.contains(&g) {
+                    suspects.push(g);
                 }
             }
         }

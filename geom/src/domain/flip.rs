@@ -22,9 +22,6 @@ use serde::{Deserialize, Serialize};
 /// reflects the patch's shape rather than the first step's wiggle.
 const SHAPE_REACH: f64 = 0.25;
 
-/// A patch corner narrower than this (radians) is a sliver.
-const SLIVER_ANGLE: f64 = 0.25 * std::f64::consts::PI;
-
 /// Options of [`flip_paths`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -36,16 +33,13 @@ pub struct FlipOptions {
     /// Only where the quadrilateral's angles at the path's ends stay below π times this
     /// (convex, so the new diagonal runs inside it, away from the old ends).
     pub max_end_angle: f64,
-    /// `voronoi`: before the target layout is built, raise source anchors to this many paths
-    /// ([`raise_valence`]; 0 disables).
-    pub min_valence: usize,
     /// Also require the new diagonal to be shorter than the old path on both meshes.
     pub shorter_only: bool,
 }
 
 impl Default for FlipOptions {
     fn default() -> Self {
-        Self { rounds: 3, threshold: 0.9, max_end_angle: 0.9, min_valence: 3, shorter_only: true }
+        Self { rounds: 3, threshold: 0.9, max_end_angle: 0.9, shorter_only: true }
     }
 }
 
@@ -206,77 +200,6 @@ pub fn flip_paths(
         }
     }
     Ok(res)
-}
-
-/// Raises every anchor of a single layout that has fewer than `min` paths and a sliver corner
-/// to `min` paths by flipping a path facing it in one of its patches (the quadrilateral's
-/// other diagonal then ends at the anchor). Run on the source layout before the target is built: an
-/// anchor with two paths puts no cyclic-order constraint on the target, which may then wind
-/// its two paths the other way round (a swirl); with three the order is enforced. The far
-/// ends keep at least `min` paths. Returns the number of flips.
-///
-/// # Errors
-/// `Cancelled`; `Error::Internal` if a lifted path cannot be restored.
-pub fn raise_valence(t: &mut Tracer, min: usize, progress: &mut dyn Progress) -> Result<usize> {
-    let mut flips = 0;
-    let max_end = std::f64::consts::PI * FlipOptions::default().max_end_angle;
-    for v in 0..t.anchors().len() as u32 {
-        let mut guard = 0;
-        // Only anchors whose patches pinch to a sliver there: an anchor at the tip of a limb
-        // has two paths running down either side, and a third would wrap around the limb.
-        let pinched = walks(t).iter().any(|w| {
-            (0..w.halves.len())
-                .any(|i| t.half_start(w.halves[i]) == v && corner_angle(t, w, i).is_some_and(|a| a < SLIVER_ANGLE))
-        });
-        if !pinched {
-            continue;
-        }
-        while t.rotation(v).len() < min && guard < 4 {
-            guard += 1;
-            progress.check()?;
-            let all = walks(t);
-            let mut done = false;
-            // Each triangle with a corner at v: its side opposite v, and the triangle beyond.
-            let halves: Vec<Half> = t.rotation(v).iter().map(|&(_, h)| h).collect();
-            for h in halves {
-                let Some(w1) = walk_of(&all, h) else { continue };
-                if w1.halves.len() != 3 {
-                    continue;
-                }
-                // w1 = [v->x, x->y, y->v]; the opposite half x->y belongs to path o.
-                let opp = w1.halves[1];
-                let o = opp / 2;
-                let Some(w2) = walk_of(&all, opp ^ 1) else { continue };
-                if w2.halves.len() != 3 || w2.halves.contains(&opp) {
-                    continue;
-                }
-                let (x, y) = (t.half_start(opp), t.half_end(opp));
-                let z = t.half_start(w2.halves[2]);
-                if t.rotation(x).len() <= min || t.rotation(y).len() <= min || [v, x, y].contains(&z) {
-                    continue;
-                }
-                // Convex at x and y, so the new diagonal runs inside the quadrilateral.
-                let convex = |i1: usize, i2: usize| {
-                    matches!((corner_angle(t, &w1, i1), corner_angle(t, &w2, i2)),
-                        (Some(p), Some(q)) if p + q < max_end)
-                };
-                if !(convex(1, 1) && convex(2, 0)) {
-                    continue;
-                }
-                // New path v -> z: leaves v inside w1's corner, reaches z inside w2's.
-                let (sa, sb) = (w1.sector(t, 0), w2.sector(t, 2));
-                if t.replace(o, v, z, sa, sb)?.is_some() {
-                    flips += 1;
-                    done = true;
-                    break;
-                }
-            }
-            if !done {
-                break;
-            }
-        }
-    }
-    Ok(flips)
 }
 
 #[cfg(test)]

@@ -92,7 +92,6 @@ pub fn run_map(
         let (mut st, mut tt) = (st?, tt?);
         let built = match spec.method {
             Method::Voronoi => voronoi::source_layout(&mut st, chi, &o.layout, progress).and_then(|(cl, mut s)| {
-                s.flipped = crate::domain::flip::raise_valence(&mut st, o.layout.flip.min_valence, progress)?;
                 let t = voronoi::target_layout_with_restarts(&st, &cl, &mut tt, &o.layout, 8, progress)?;
                 s.postponed = t.postponed;
                 s.failed_traces += t.failed_traces;
@@ -126,7 +125,7 @@ pub fn run_map(
     };
     clock.lap("layout");
     let (mut st, mut tt, mut stats) = (st, tt, stats);
-    stats.flipped += crate::domain::flip::flip_paths(&mut st, &mut tt, &o.layout.flip, progress)?.flipped;
+    stats.flipped = crate::domain::flip::flip_paths(&mut st, &mut tt, &o.layout.flip, progress)?.flipped;
     clock.lap("flip");
     let rounds = o.layout.straighten_rounds;
     let (a, b) = both(

@@ -172,7 +172,15 @@ async fn rest_and_grpc(env: &Env) {
     let man = geom::io::read_path(&shared(SMPL.0), &Default::default()).unwrap().mesh;
     assert_eq!(sot.faces(), man.faces());
 
-    // Cancel a running job.
+    // Cancel a running job: the pair subdivided once (27.5k vertices each), so the job runs for
+    // seconds, well past the worker's one-second heartbeat that carries the cancel request.
+    let fine = |name: &str| {
+        let m = geom::io::read_path(&shared(name), &Default::default()).unwrap().mesh;
+        geom::io::write(&geom::mesh::shapes::subdivide(&m, 1), geom::io::Format::Obj)
+    };
+    let (_, fs) = api.upload_bytes(fine(SMPL.0)).await;
+    let (_, ft) = api.upload_bytes(fine(SMPL.1)).await;
+    let (src, tgt) = (fs["id"].as_str().unwrap().to_string(), ft["id"].as_str().unwrap().to_string());
     let (_, c) = api.submit(&src, &tgt, &identity_spec("voronoi", 24)).await;
     let cid = c["id"].as_str().unwrap().to_string();
     let running = wait_for(Duration::from_secs(60), || {

@@ -69,6 +69,26 @@ fn try_link(ts: &mut [&mut Tracer], ends: [(usize, usize); 2], stats: &mut Compl
     Ok(true)
 }
 
+/// Would removing path `p` disconnect the layout graph or leave an anchor without paths?
+fn disconnects(t: &Tracer, p: u32) -> bool {
+    let na = t.anchors().len();
+    let mut parent: Vec<usize> = (0..na).collect();
+    let mut degree = vec![0usize; na];
+    for (i, q) in t.paths().iter().enumerate() {
+        if i == p as usize {
+            continue;
+        }
+        degree[q.a as usize] += 1;
+        degree[q.b as usize] += 1;
+        let (x, y) = (super::uf_find(&mut parent, q.a as usize), super::uf_find(&mut parent, q.b as usize));
+        parent[x] = y;
+    }
+    let q = &t.paths()[p as usize];
+    degree[q.a as usize] == 0
+        || degree[q.b as usize] == 0
+        || super::uf_find(&mut parent, q.a as usize) != super::uf_find(&mut parent, q.b as usize)
+}
+
 /// Adds paths until every region is a triangle and the layout is cellular (`V - E + W = χ`).
 ///
 /// # Errors
@@ -165,6 +185,8 @@ pub fn complete(
             let victim = sides
                 .into_iter()
                 .filter(|&p| ripped.iter().filter(|&&q| q == pair(p)).count() < MAX_RIPS_PER_PAIR)
+                // Never a bridge or an anchor's last path: the layout must stay connected.
+                .filter(|&p| !disconnects(t0, p))
                 .min_by(|&x, &y| t0.paths()[x as usize].length.total_cmp(&t0.paths()[y as usize].length));
             if let Some(p) = victim {
                 ripped.push(pair(p));
@@ -211,5 +233,28 @@ pub fn complete(
             "the layout does not cut the surface into disks and no joining path could be traced".into(),
         )
         .into());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{VertexId, shapes};
+
+    #[test]
+    fn bridges_and_last_paths_are_not_ripped() {
+        let m = shapes::icosphere(3);
+        let anchors = [VertexId(0), VertexId(5), VertexId(11), VertexId(30)];
+        let mut t = Tracer::new(&m, &anchors, &Default::default()).unwrap();
+        // A chain 0 - 1 - 2: both paths are bridges; anchor 3 has no path at all.
+        let p01 = t.trace_insert(&TraceRequest { a: 0, b: 1, ..Default::default() }).unwrap().unwrap();
+        let p12 = t.trace_insert(&TraceRequest { a: 1, b: 2, ..Default::default() }).unwrap().unwrap();
+        assert!(disconnects(&t, p01) && disconnects(&t, p12));
+        // Closing the triangle 0 - 1 - 2: no path is a bridge any more.
+        let p20 = t.trace_insert(&TraceRequest { a: 2, b: 0, ..Default::default() }).unwrap().unwrap();
+        assert!(!disconnects(&t, p01) && !disconnects(&t, p12) && !disconnects(&t, p20));
+        // A dangling path to anchor 3 is its last one.
+        let p23 = t.trace_insert(&TraceRequest { a: 2, b: 3, ..Default::default() }).unwrap().unwrap();
+        assert!(disconnects(&t, p23));
     }
 }

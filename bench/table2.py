@@ -4,7 +4,7 @@
 Usage: python3 bench/table2.py [SURFMAP_BINARY] [CASE_FILTER]
 (default binary: $CARGO_TARGET_DIR/release/surfmap or target/release/surfmap). Needs numpy+scipy.
 Cases: same-shape pairs with known correspondence (shuffled vertex order, twist, bend, another
-triangulation by subdivision) with farthest-point anchors; SMPL man/woman (i <-> i); Sumner
+triangulation by subdivision, and by QEM simplification to half the vertices) with farthest-point anchors; SMPL man/woman (i <-> i); Sumner
 cat/lion (55 markers); genus 1 and 2. Prints a markdown table; times are wall-clock medians of 3.
 """
 import json
@@ -109,7 +109,23 @@ def same_shape(tmp, name, path, kind, k):
     return src, tgt, anchors, gt
 
 
-def cases(tmp):
+def simplified(tmp, binary, name, path, k):
+    """Source: the mesh simplified to half its vertices by `surfmap convert --simplify` (every
+    kept vertex is an original one); target: the mesh. Ground truth: the kept indices."""
+    V, _ = mm.load_mesh(path)
+    src = os.path.join(tmp, f"{name}_s.off")
+    gt = os.path.join(tmp, f"{name}_gt.txt")
+    subprocess.run([binary, "convert", path, src, "--simplify", str(len(V) // 2), "--kept", gt],
+                   check=True, capture_output=True)
+    kept = np.loadtxt(gt, dtype=np.int64)
+    VS, _ = mm.load_mesh(src)
+    tgt = os.path.join(tmp, f"{name}_t.off")
+    VT, FT = mm.load_mesh(path)
+    write_off(tgt, VT.astype(float), FT)
+    return src, tgt, [[i, int(kept[i])] for i in fps(VS.astype(float), k)], gt
+
+
+def cases(tmp, binary):
     out = []
     for name, path, kind, k in [
         ("cow shuffled", "cow.off", "shuffle", 24),
@@ -127,6 +143,11 @@ def cases(tmp):
     ]:
         tag = name.split()[0].replace("/", "_") + "_" + kind
         s, t, a, gt = same_shape(tmp, tag, os.path.join(M, path), kind, k)
+        out.append((name, s, t, a, gt))
+    for name, path in [("cow simplified 50% (retriangulation)", "cow.off"),
+                       ("homer simplified 50% (retriangulation)", "homer.obj")]:
+        tag = name.split()[0] + "_simplified"
+        s, t, a, gt = simplified(tmp, binary, tag, os.path.join(M, path), 24)
         out.append((name, s, t, a, gt))
     man = os.path.join(M, "registered/smpl_human/human_man.obj")
     woman = os.path.join(M, "registered/smpl_human/human_woman.obj")
@@ -175,7 +196,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         print("| case | #v (s/t) | n_a | method | time s | patches | E_ang | L2 | flips s→t/t→s | area | off-surface | anchor err | gt mean |")
         print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-        for name, s, t, a, gt in cases(tmp):
+        for name, s, t, a, gt in cases(tmp, binary):
             if filt not in name:
                 continue
             nv = f"{len(mm.load_mesh(s)[0])}/{len(mm.load_mesh(t)[0])}"

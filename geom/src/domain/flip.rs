@@ -152,7 +152,7 @@ pub fn flip_paths(
             if st.rotation(a).len() <= 3 || st.rotation(b).len() <= 3 {
                 continue;
             }
-            let (Some((s_sum, c, d, w1, w2)), Some((t_sum, c2, d2, _, _))) =
+            let (Some((s_sum, c, d, w1, w2)), Some((t_sum, c2, d2, tw1, tw2))) =
                 (facing_angles(st, p, max_end), facing_angles(tt, p, max_end))
             else {
                 continue;
@@ -170,9 +170,6 @@ pub fn flip_paths(
             // The new path c -> d leaves c inside w1's corner and reaches d inside w2's.
             let corner = |t: &Tracer, w: &Walk| w.sector(t, 2);
             let (sa_s, sb_s) = (corner(st, &w1), corner(st, &w2));
-            let tw1 = walk_of(&walks(tt), 2 * p);
-            let tw2 = walk_of(&walks(tt), 2 * p + 1);
-            let (Some(tw1), Some(tw2)) = (tw1, tw2) else { continue };
             let (sa_t, sb_t) = (corner(tt, &tw1), corner(tt, &tw2));
             let Some(old_s) = st.replace(p, c, d, sa_s, sb_s)? else {
                 res.refused += 1;

@@ -14,6 +14,7 @@ pub mod crossparam;
 pub mod domain;
 pub mod error;
 pub mod geodesic;
+pub mod homology;
 pub mod io;
 pub mod linalg;
 pub mod map;

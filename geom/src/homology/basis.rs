@@ -1,0 +1,279 @@
+//! Canonical homology basis through one base vertex (Carner et al. 2005, section 3.2).
+//!
+//! The paper finds candidate loops as shortest paths between preimages of the base vertex in
+//! the universal covering space and searches their intersection matrices for a symplectic set.
+//! We build the same object incrementally and certify it combinatorially, which never needs
+//! floating-point crossing tests: for each handle, `a` is the shortest simple non-separating
+//! loop through the current corner (tree–cotree over the surface cut so far: the covering-space
+//! search restricted to one sheet, see [`super::search`]), and `b` is the shortest path that
+//! leaves `a` on one side and comes back on the other. Both avoid everything cut before, so the
+//! loops meet only at the base vertex, every `a_i` crosses `b_i` once there, and cutting them
+//! inserts the commutator `a b a⁻¹ b⁻¹` at the corner. The next handle starts at a corner
+//! between commutators, so the final disk reads `a1 b1 a1⁻¹ b1⁻¹ … ag bg ag⁻¹ bg⁻¹`; the word
+//! and the intersection matrix are read back from the result and checked.
+//!
+//! `basis_index = k` takes the `k`-th shortest class (mod 2) for the first loop, giving the
+//! enumeration of bases, shortest first. Where the mesh is too coarse for disjoint loops (the
+//! paper's "refine the mesh locally where curves would share edges"), the base vertex's
+//! valence is raised and, failing that, the mesh is subdivided at edge midpoints.
+
+use super::cut::{CutMesh, cut_along, path_edges};
+use super::refine::Refined;
+use super::search::{interior_path, nonseparating_loops};
+use super::word::{Letter, canonical_rotation, canonical_rotations, intersection_matrix, read_word};
+use crate::error::{Error, InputError, Result};
+use crate::mesh::{Mesh, VertexId};
+use crate::topology;
+use serde::{Deserialize, Serialize};
+
+/// Options for [`canonical_basis`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CanonicalBasisOptions {
+    /// Which basis of the enumeration (0 = shortest).
+    pub basis_index: usize,
+    /// Rounds of midpoint subdivision allowed when loops would touch.
+    pub max_subdivisions: usize,
+}
+
+impl Default for CanonicalBasisOptions {
+    fn default() -> Self {
+        Self { basis_index: 0, max_subdivisions: 2 }
+    }
+}
+
+/// A canonical basis and the disk it cuts.
+#[derive(Debug, Clone)]
+pub struct CanonicalBasisResult {
+    /// The refinement the loops live on.
+    pub refined: Refined,
+    pub base: VertexId,
+    /// `a1, b1, a2, b2, …`: vertex lists from the base back to the base.
+    pub loops: Vec<Vec<VertexId>>,
+    /// Algebraic intersection numbers (`loops[i] · loops[j]`).
+    pub intersection: Vec<Vec<i32>>,
+    /// The refined mesh cut open along the loops.
+    pub disk: CutMesh,
+    /// The disk's boundary (vertices of `disk.mesh`), starting at the corner before `a1`.
+    pub walk: Vec<VertexId>,
+    /// Positions in `walk` of the `4g` corners.
+    pub corners: Vec<usize>,
+    /// The boundary word, one letter per side.
+    pub word: Vec<Letter>,
+    /// Subdivision rounds that were needed.
+    pub subdivisions: usize,
+}
+
+impl CanonicalBasisResult {
+    pub fn genus(&self) -> usize {
+        self.loops.len() / 2
+    }
+
+    /// The word as text, e.g. `a1 b1 a1^-1 b1^-1`.
+    pub fn word_text(&self) -> String {
+        self.word
+            .iter()
+            .map(|l| {
+                let name = if l.loop_id % 2 == 0 { 'a' } else { 'b' };
+                let inv = if l.dir < 0 { "^-1" } else { "" };
+                format!("{name}{}{inv}", l.loop_id / 2 + 1)
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+}
+
+/// Computes a canonical homology basis of a closed mesh through `base`.
+///
+/// # Errors
+/// `InvalidInput` for a mesh with boundary or genus 0 (no basis), or when no disjoint basis
+/// is found within the allowed refinement; `Internal` when a certificate fails.
+pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions) -> Result<CanonicalBasisResult> {
+    let s = topology::summary(mesh);
+    if s.boundary_loops != 0 {
+        return Err(InputError::Invalid(
+            "canonical basis: the mesh has boundary loops (treat them as features)".into(),
+        )
+        .into());
+    }
+    if s.genus <= 0 {
+        return Err(InputError::Invalid("canonical basis: genus 0 has no homology basis".into()).into());
+    }
+    if base.idx() >= mesh.n_vertices() {
+        return Err(InputError::OutOfRange { what: "base vertex", index: base.idx(), count: mesh.n_vertices() }.into());
+    }
+    let g = s.genus as usize;
+    let mut refined = Refined::identity(mesh).raise_valence(base, 8 * g + 8)?;
+    for round in 0..=opts.max_subdivisions {
+        if let Ok(loops) = search(&refined.mesh, base, g, opts.basis_index)? {
+            return finish(refined, base, loops, round);
+        }
+        if round < opts.max_subdivisions {
+            refined = refined.subdivide()?.raise_valence(base, 8 * g + 8)?;
+        }
+    }
+    Err(InputError::Invalid(format!(
+        "canonical basis: no {}-loop basis through vertex {} with disjoint loops after {} subdivisions",
+        2 * g,
+        base.0,
+        opts.max_subdivisions
+    ))
+    .into())
+}
+
+/// Handle by handle on the surface cut so far; `None` when loops would have to touch.
+type Loops = Vec<Vec<VertexId>>;
+/// A finished basis, or the loops found before the search got stuck.
+type Searched = std::result::Result<Loops, Loops>;
+
+/// `Ok(Err(partial))`: the search got stuck; `partial` holds the loops found so far (the
+/// one being crossed included), whose chords the caller splits before trying again.
+fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<Searched> {
+    let mut s = CutMesh { mesh: mesh.clone(), orig: (0..mesh.n_vertices()).map(VertexId::from_idx).collect() };
+    let mut corner = base;
+    let mut loops: Vec<Vec<VertexId>> = Vec::with_capacity(2 * g);
+    for handle in 0..g {
+        let skip = if handle == 0 { first } else { 0 };
+        let cands = nonseparating_loops(&s.mesh, corner, skip + 1)?;
+        let Some(a) = cands.into_iter().nth(skip) else {
+            debug(&format!("handle {handle}: no non-separating loop at the corner"));
+            return Ok(Err(Vec::new()));
+        };
+        let s1 = compose(&s, cut_along(&s.mesh, &path_edges(&s.mesh, std::slice::from_ref(&a))?)?);
+        let local: Vec<VertexId> = copies_of(&s1, &s, corner);
+        if local.len() < 2 {
+            debug(&format!("handle {handle}: corner has {} copies after cutting a", local.len()));
+            return Ok(Err(loops));
+        }
+        // From the copy between a's two ends to a copy on either outer side.
+        let from = if handle == 0 {
+            local[0]
+        } else {
+            match middle_copy(&s1, &s, &local) {
+                Some(m) => m,
+                None => {
+                    debug(&format!("handle {handle}: no middle copy among {}", local.len()));
+                    return Ok(Err(loops));
+                }
+            }
+        };
+        let to: Vec<VertexId> = local.iter().copied().filter(|&c| c != from).collect();
+        let Some(b) = interior_path(&s1.mesh, from, &to) else {
+            debug(&format!("handle {handle}: no path from one side of a to the other"));
+            loops.push(a.iter().map(|&v| s.orig[v.idx()]).collect());
+            return Ok(Err(loops));
+        };
+        let s2 = compose(&s1, cut_along(&s1.mesh, &path_edges(&s1.mesh, std::slice::from_ref(&b))?)?);
+        loops.push(a.iter().map(|&v| s.orig[v.idx()]).collect());
+        loops.push(b.iter().map(|&v| s1.orig[v.idx()]).collect());
+        let Some(w) = read_word(&s2.mesh, &s2.orig, base, &loops) else {
+            debug(&format!("handle {handle}: cut surface word unreadable"));
+            return Ok(Err(loops));
+        };
+        // Any corner between commutators will do: take the one with the widest fan.
+        let Some(c) = canonical_rotations(&w.letters)
+            .into_iter()
+            .map(|r| w.walk[w.corners[r]])
+            .max_by_key(|&c| (s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0)))
+        else {
+            return Err(Error::Internal(format!("basis: handle {} left a non-canonical word", handle + 1)));
+        };
+        corner = c;
+        s = s2;
+    }
+    Ok(Ok(loops))
+}
+
+/// `inner` cut from `outer.mesh`; returns it with `orig` pointing into the uncut mesh.
+fn compose(outer: &CutMesh, inner: CutMesh) -> CutMesh {
+    let orig = inner.orig.iter().map(|&v| outer.orig[v.idx()]).collect();
+    CutMesh { mesh: inner.mesh, orig }
+}
+
+/// The copies in `s1` of `corner` (a vertex of `s`).
+fn copies_of(s1: &CutMesh, s: &CutMesh, corner: VertexId) -> Vec<VertexId> {
+    (0..s1.mesh.n_vertices()).map(VertexId::from_idx).filter(|&v| s1_local(s1, s, v) == Some(corner)).collect()
+}
+
+/// The vertex of `s` that vertex `v` of `s1` (cut from `s`) copies: found through a face, since
+/// both meshes list faces in the same order.
+fn s1_local(s1: &CutMesh, s: &CutMesh, v: VertexId) -> Option<VertexId> {
+    let h = s1.mesh.outgoing(v).next()?;
+    Some(s.mesh.tail(h))
+}
+
+/// The copy whose two boundary edges are both new (it lies between the cut loop's ends).
+fn middle_copy(s1: &CutMesh, s: &CutMesh, copies: &[VertexId]) -> Option<VertexId> {
+    copies.iter().copied().find(|&c| {
+        let nb: Vec<VertexId> = s1.mesh.vertex_neighbors(c).collect();
+        let (Some(&first), Some(&last)) = (nb.first(), nb.last()) else { return false };
+        let old = |w: VertexId| {
+            let (Some(sc), Some(sw)) = (s1_local(s1, s, c), s1_local(s1, s, w)) else { return true };
+            super::cut::edge_between(&s.mesh, sc, sw).is_some_and(|e| s.mesh.is_boundary_edge(e))
+        };
+        !old(first) && !old(last)
+    })
+}
+
+/// Splits chords (edges off the loops with both ends on them), cuts the disk, certifies it.
+fn finish(
+    refined: Refined,
+    base: VertexId,
+    loops: Vec<Vec<VertexId>>,
+    subdivisions: usize,
+) -> Result<CanonicalBasisResult> {
+    let on_cut = {
+        let mut f = vec![false; refined.mesh.n_vertices()];
+        for l in &loops {
+            for v in l {
+                f[v.idx()] = true;
+            }
+        }
+        f
+    };
+    let cut = path_edges(&refined.mesh, &loops)?;
+    let chords: Vec<[VertexId; 2]> = (0..refined.mesh.n_edges())
+        .filter(|&e| !cut[e])
+        .map(|e| refined.mesh.edge_vertices(crate::mesh::EdgeId::from_idx(e)))
+        .filter(|[a, b]| on_cut[a.idx()] && on_cut[b.idx()])
+        .collect();
+    let refined = refined.split_edges(&chords)?;
+    let disk = cut_along(&refined.mesh, &path_edges(&refined.mesh, &loops)?)?;
+    let chi = topology::euler_characteristic(&disk.mesh);
+    let w = read_word(&disk.mesh, &disk.orig, base, &loops)
+        .ok_or_else(|| Error::Internal("basis: the cut surface does not have one boundary loop".into()))?;
+    let r =
+        canonical_rotation(&w.letters).ok_or_else(|| Error::Internal("basis: final word is not canonical".into()))?;
+    if chi != 1 {
+        return Err(Error::Internal(format!("basis: the cut surface has Euler characteristic {chi}, not 1")));
+    }
+    // Relabel: side 4j is a_{j+1}, side 4j+1 is b_{j+1}, oriented as read.
+    let n = w.letters.len();
+    let mut labeled = Vec::with_capacity(loops.len());
+    for j in 0..n / 4 {
+        for k in 0..2 {
+            let l = w.letters[(r + 4 * j + k) % n];
+            let mut lp = loops[l.loop_id].clone();
+            if l.dir < 0 {
+                lp.reverse();
+            }
+            labeled.push(lp);
+        }
+    }
+    let start = w.corners[r];
+    let m = w.walk.len();
+    let walk: Vec<VertexId> = (0..m).map(|i| w.walk[(start + i) % m]).collect();
+    let w2 = read_word(&disk.mesh, &disk.orig, base, &labeled)
+        .ok_or_else(|| Error::Internal("basis: relabeled word unreadable".into()))?;
+    let r2 = w2.corners.iter().position(|&c| w2.walk[c] == walk[0]).unwrap_or(0);
+    let word: Vec<Letter> = (0..n).map(|i| w2.letters[(r2 + i) % n]).collect();
+    let corners: Vec<usize> = (0..m).filter(|&i| disk.orig[walk[i].idx()] == base).collect();
+    let intersection = intersection_matrix(&refined.mesh, base, &labeled);
+    Ok(CanonicalBasisResult { refined, base, loops: labeled, intersection, disk, walk, corners, word, subdivisions })
+}
+
+fn debug(msg: &str) {
+    if std::env::var_os("SURFMAP_DEBUG").is_some() {
+        eprintln!("homology basis: {msg}");
+    }
+}

@@ -1,0 +1,145 @@
+//! Z2 cohomology by tree–cotree (Eppstein 2003; Erickson & Whittlesey 2005): a spanning tree
+//! `T` of the vertices, a spanning tree `C` of the dual graph avoiding `T`, and the `2g` edges in
+//! neither. Each leftover edge gets a closed cocycle (zero on `T`, one on itself, fixed on `C`
+//! by peeling the cotree from its leaves), so a closed edge path is non-separating exactly when
+//! the XOR of its edges' masks is non-zero.
+//!
+//! A surface with one boundary loop is treated as closed by capping the loop with one face
+//! (the cap is the cotree's root); a loop in the surface separates it exactly when it separates
+//! the capped surface.
+
+use crate::error::{Error, Result};
+use crate::mesh::{EdgeId, Mesh, VertexId};
+use crate::topology::boundary_loops;
+use std::collections::VecDeque;
+
+/// Cocycle masks per edge (bit `k`: the `k`-th leftover edge's cocycle).
+#[derive(Debug, Clone)]
+pub struct Cohomology {
+    pub mask: Vec<u64>,
+    /// Number of leftover edges (`2g` of the capped surface).
+    pub rank: usize,
+}
+
+/// Builds the cohomology masks. `tree_parent[v]` is the parent edge of `v` in a tree that
+/// must contain every edge given (others are added to span all vertices).
+///
+/// # Errors
+/// `InvalidInput`-free: `Internal` when the surface has more than 64 generators or more than one
+/// boundary loop.
+pub fn z2_cohomology(mesh: &Mesh, tree_edges: &[EdgeId]) -> Result<Cohomology> {
+    let (nv, ne, nf) = (mesh.n_vertices(), mesh.n_edges(), mesh.n_faces());
+    let loops = boundary_loops(mesh);
+    if loops.len() > 1 {
+        return Err(Error::Internal("cohomology: more than one boundary loop".into()));
+    }
+    // Spanning tree: the given edges, then a BFS over all edges from every covered vertex.
+    let mut in_tree = vec![false; ne];
+    let mut covered = vec![false; nv];
+    let mut uf = UnionFind::new(nv);
+    for &e in tree_edges {
+        let [a, b] = mesh.edge_vertices(e);
+        if uf.union(a.idx(), b.idx()) {
+            in_tree[e.idx()] = true;
+        }
+        covered[a.idx()] = true;
+        covered[b.idx()] = true;
+    }
+    let mut queue: VecDeque<VertexId> = (0..nv).filter(|&v| covered[v]).map(VertexId::from_idx).collect();
+    if queue.is_empty() && nv > 0 {
+        covered[0] = true;
+        queue.push_back(VertexId(0));
+    }
+    while let Some(v) = queue.pop_front() {
+        for h in mesh.outgoing(v).collect::<Vec<_>>() {
+            for (x, e) in [(mesh.head(h), mesh.edge(h)), (mesh.tail(h.prev()), mesh.edge(h.prev()))] {
+                if !covered[x.idx()] && uf.union(v.idx(), x.idx()) {
+                    covered[x.idx()] = true;
+                    in_tree[e.idx()] = true;
+                    queue.push_back(x);
+                }
+            }
+        }
+    }
+    // Dual graph: faces plus the cap (index nf) when there is a boundary.
+    let cap = if loops.is_empty() { None } else { Some(nf) };
+    let root = cap.unwrap_or(0);
+    let n_dual = nf + usize::from(cap.is_some());
+    let dual_ends = |e: EdgeId| -> (usize, usize) {
+        let (f0, f1) = mesh.edge_faces(e);
+        (f0.idx(), f1.map_or(nf, |f| f.idx()))
+    };
+    let mut parent_edge = vec![u32::MAX; n_dual];
+    let mut seen = vec![false; n_dual];
+    let mut order = Vec::with_capacity(n_dual);
+    let mut in_cotree = vec![false; ne];
+    seen[root] = true;
+    let mut dq = VecDeque::from([root]);
+    let cap_edges: Vec<EdgeId> = loops.first().map(|l| l.iter().map(|&h| mesh.edge(h)).collect()).unwrap_or_default();
+    let node_edges = |u: usize| -> Vec<EdgeId> {
+        if Some(u) == cap {
+            cap_edges.clone()
+        } else {
+            (0..3).map(|k| mesh.edge(crate::mesh::HalfedgeId::of(crate::mesh::FaceId::from_idx(u), k))).collect()
+        }
+    };
+    while let Some(u) = dq.pop_front() {
+        order.push(u);
+        for e in node_edges(u) {
+            if in_tree[e.idx()] {
+                continue;
+            }
+            let (a, b) = dual_ends(e);
+            let w = if a == u { b } else { a };
+            if !seen[w] {
+                seen[w] = true;
+                parent_edge[w] = e.0;
+                in_cotree[e.idx()] = true;
+                dq.push_back(w);
+            }
+        }
+    }
+    let mut mask = vec![0u64; ne];
+    let mut rank = 0;
+    for e in 0..ne {
+        if !in_tree[e] && !in_cotree[e] {
+            if rank >= 64 {
+                return Err(Error::Internal("cohomology: more than 64 generators".into()));
+            }
+            mask[e] = 1 << rank;
+            rank += 1;
+        }
+    }
+    for &u in order.iter().rev() {
+        if u == root {
+            continue;
+        }
+        let pe = parent_edge[u] as usize;
+        let m = node_edges(u).iter().filter(|e| e.idx() != pe).fold(0u64, |acc, e| acc ^ mask[e.idx()]);
+        mask[pe] = m;
+    }
+    Ok(Cohomology { mask, rank })
+}
+
+struct UnionFind(Vec<u32>);
+impl UnionFind {
+    fn new(n: usize) -> Self {
+        UnionFind((0..n as u32).collect())
+    }
+    fn find(&mut self, mut x: usize) -> usize {
+        while self.0[x] as usize != x {
+            let p = self.0[x] as usize;
+            self.0[x] = self.0[p];
+            x = p;
+        }
+        x
+    }
+    fn union(&mut self, a: usize, b: usize) -> bool {
+        let (ra, rb) = (self.find(a), self.find(b));
+        if ra == rb {
+            return false;
+        }
+        self.0[ra] = rb as u32;
+        true
+    }
+}

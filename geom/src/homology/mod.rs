@@ -1,0 +1,18 @@
+//! Method `homology` (Carner, Jin, Gu, Qin 2005): canonical homology bases through one base
+//! vertex, the 4g-gon fundamental domain they cut, and maps between two surfaces through it.
+//!
+//! - [`refine`]: midpoint refinement that remembers where every refined face lies.
+//! - [`cut`]: slicing a mesh open along edge paths.
+//! - [`cocycle`]: Z2 cohomology by tree–cotree (which loops are non-separating).
+//! - [`search`]: shortest non-separating loops and side-to-side paths on a cut surface.
+//! - [`word`]: boundary words, the canonical rotation, intersection numbers at the base.
+//! - [`basis`]: the canonical basis itself.
+
+pub mod basis;
+pub mod cocycle;
+pub mod cut;
+pub mod refine;
+pub mod search;
+pub mod word;
+
+pub use basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis};

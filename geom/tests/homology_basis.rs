@@ -79,7 +79,6 @@ fn rocker_arm_2500() {
 }
 
 #[test]
-#[ignore = "known gap: the incremental search runs out of room between loops near the base vertex"]
 fn eight() {
     check("eight.off", 2);
 }

@@ -105,8 +105,16 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
     let g = s.genus as usize;
     let mut refined = Refined::identity(mesh).raise_valence(base, 8 * g + 8)?;
     for round in 0..=opts.max_subdivisions {
-        if let Ok(loops) = search(&refined.mesh, base, g, opts.basis_index)? {
-            return finish(refined, base, loops, round);
+        // A crowded base vertex first gets more edges (twice, then four times as many).
+        let mut local = refined.clone();
+        for extra in 0..3 {
+            if let Ok(loops) = search(&local.mesh, base, g, opts.basis_index)? {
+                return finish(local, base, loops, round);
+            }
+            if extra < 2 {
+                let valence = local.mesh.outgoing(base).count();
+                local = local.raise_valence(base, 2 * valence)?;
+            }
         }
         if round < opts.max_subdivisions {
             refined = refined.subdivide()?.raise_valence(base, 8 * g + 8)?;
@@ -170,11 +178,12 @@ fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<Searche
             debug(&format!("handle {handle}: cut surface word unreadable"));
             return Ok(Err(loops));
         };
-        // Any corner between commutators will do: take the one with the widest fan.
+        // Any corner between commutators will do: take the one that reaches the most interior
+        // (loops that run side by side can pen a corner into a small pocket), then the widest.
         let Some(c) = canonical_rotations(&w.letters)
             .into_iter()
             .map(|r| w.walk[w.corners[r]])
-            .max_by_key(|&c| (s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0)))
+            .max_by_key(|&c| (reachable_interior(&s2.mesh, c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0)))
         else {
             return Err(Error::Internal(format!("basis: handle {} left a non-canonical word", handle + 1)));
         };
@@ -182,6 +191,26 @@ fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<Searche
         s = s2;
     }
     Ok(Ok(loops))
+}
+
+/// Interior vertices reachable from `corner` through interior vertices.
+fn reachable_interior(mesh: &Mesh, corner: VertexId) -> usize {
+    let mut seen = vec![false; mesh.n_vertices()];
+    let mut stack: Vec<VertexId> = mesh.vertex_neighbors(corner).filter(|&w| !mesh.is_boundary_vertex(w)).collect();
+    for w in &stack {
+        seen[w.idx()] = true;
+    }
+    let mut count = 0;
+    while let Some(v) = stack.pop() {
+        count += 1;
+        for w in mesh.vertex_neighbors(v) {
+            if !seen[w.idx()] && !mesh.is_boundary_vertex(w) {
+                seen[w.idx()] = true;
+                stack.push(w);
+            }
+        }
+    }
+    count
 }
 
 /// `inner` cut from `outer.mesh`; returns it with `orig` pointing into the uncut mesh.

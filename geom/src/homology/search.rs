@@ -25,17 +25,36 @@ impl Ord for Item {
     }
 }
 
+/// Cost factor for stepping onto a vertex next to the boundary (other than the corner): paths
+/// keep a vertex of clearance from the loops already cut where they can, which leaves room for
+/// the paths that must cross or follow them later.
+const CLEARANCE: f64 = 3.0;
+
+/// Interior vertices with a boundary neighbour other than `except`.
+fn near_boundary(mesh: &Mesh, except: &[VertexId]) -> Vec<bool> {
+    (0..mesh.n_vertices())
+        .map(|v| {
+            let v = VertexId::from_idx(v);
+            !mesh.is_boundary_vertex(v)
+                && mesh.vertex_neighbors(v).any(|w| mesh.is_boundary_vertex(w) && !except.contains(&w))
+        })
+        .collect()
+}
+
 /// Shortest-path tree over the vertices `allowed` admits, from `sources`.
 struct Tree {
     dist: Vec<f64>,
     pred: Vec<u32>,
 }
 
+/// `first` filters the steps out of the sources.
 fn dijkstra(
     mesh: &Mesh,
     sources: &[VertexId],
     allowed: &dyn Fn(VertexId) -> bool,
+    first: &dyn Fn(VertexId) -> bool,
     stop: &dyn Fn(VertexId) -> bool,
+    weight: &dyn Fn(VertexId) -> f64,
 ) -> (Tree, Option<VertexId>) {
     let n = mesh.n_vertices();
     let mut dist = vec![f64::INFINITY; n];
@@ -57,11 +76,12 @@ fn dijkstra(
         }
         // Do not pass through a stop vertex or leave one (only sources may be left).
         let pv = mesh.position(v);
+        let from_source = pred[v.idx()] == u32::MAX;
         for w in mesh.vertex_neighbors(v) {
-            if done[w.idx()] || !allowed(w) {
+            if done[w.idx()] || !allowed(w) || (from_source && !first(w)) {
                 continue;
             }
-            let nd = d + (mesh.position(w) - pv).norm();
+            let nd = d + (mesh.position(w) - pv).norm() * weight(w);
             if nd < dist[w.idx()] {
                 dist[w.idx()] = nd;
                 pred[w.idx()] = v.0;
@@ -97,7 +117,15 @@ fn path_to(t: &Tree, v: VertexId) -> Vec<VertexId> {
 /// `Internal` from the cohomology construction.
 pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Result<Vec<Vec<VertexId>>> {
     let allowed = |v: VertexId| v == corner || !mesh.is_boundary_vertex(v);
-    let (tree, _) = dijkstra(mesh, &[corner], &allowed, &|_| false);
+    // At a boundary corner, keep the neighbours next to the boundary edges free of first
+    // steps, so that the crossing path has a side to arrive on.
+    let fan: Vec<VertexId> = mesh.vertex_neighbors(corner).collect();
+    let hugging: Vec<VertexId> =
+        if mesh.is_boundary_vertex(corner) && fan.len() >= 4 { vec![fan[1], fan[fan.len() - 2]] } else { Vec::new() };
+    let first_ok = |w: VertexId| !hugging.contains(&w);
+    let near = near_boundary(mesh, &[corner]);
+    let weight = |w: VertexId| if near[w.idx()] { CLEARANCE } else { 1.0 };
+    let (tree, _) = dijkstra(mesh, &[corner], &allowed, &first_ok, &|_| false, &weight);
     let n = mesh.n_vertices();
     let mut tree_edges: Vec<EdgeId> = Vec::with_capacity(n + 16);
     let mut is_tree = vec![false; mesh.n_edges()];
@@ -169,7 +197,11 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
         let corners: Vec<VertexId> =
             (0..slit.mesh.n_vertices()).map(VertexId::from_idx).filter(|v| slit.orig[v.idx()] == corner).collect();
         let room = |lp: &[VertexId]| room_at_corner(mesh, corner, lp);
-        if let Some(lp) = shortest_simple_loop(&slit, &corners, &emask, want, stem_len >= 2, &room) {
+        let first_slit = |_: VertexId| true;
+        let weight_slit = |w: VertexId| weight(slit.orig[w.idx()]);
+        if let Some(lp) =
+            shortest_simple_loop(&slit, &corners, &emask, want, stem_len >= 2, &first_slit, &weight_slit, &room)
+        {
             out.push(lp);
         }
     }
@@ -184,10 +216,12 @@ fn shortest_simple_loop(
     mask: &[u64],
     want: u64,
     by_side: bool,
+    first: &dyn Fn(VertexId) -> bool,
+    weight: &dyn Fn(VertexId) -> f64,
     room: &dyn Fn(&[VertexId]) -> bool,
 ) -> Option<Vec<VertexId>> {
     let mesh = &slit.mesh;
-    let two = two_branch_dijkstra(mesh, corners, mask, by_side);
+    let two = two_branch_dijkstra(mesh, corners, mask, by_side, first, weight);
     let mut cands: Vec<(f64, u32, u32)> = Vec::new();
     for e in 0..mesh.n_edges() {
         let e = EdgeId::from_idx(e);
@@ -231,10 +265,7 @@ fn shortest_simple_loop(
         n_room += 1;
     }
     if dbg {
-        let both = two.of.iter().filter(|o| o.len() == 2).count();
-        let one = two.of.iter().filter(|o| o.len() == 1).count();
-        eprintln!("labels: {one} single, {both} double, of {} vertices; want {want:b}", mesh.n_vertices());
-        eprintln!("simple loop: {nc} candidates, {n_touch} touching, {n_room} without room, corners {}", corners.len());
+        eprintln!("homology basis: {nc} loop candidates, {n_touch} touching, {n_room} without room");
     }
     None
 }
@@ -339,7 +370,14 @@ fn neighbors_with_edges(mesh: &Mesh, v: VertexId) -> Vec<(VertexId, EdgeId)> {
 
 /// With `by_side`, branches are the two sides of a slit ending at the corner: the corner's two
 /// copies, or the two halves of its one fan; otherwise each first edge is its own branch.
-fn two_branch_dijkstra(mesh: &Mesh, corners: &[VertexId], mask: &[u64], by_side: bool) -> TwoBranch {
+fn two_branch_dijkstra(
+    mesh: &Mesh,
+    corners: &[VertexId],
+    mask: &[u64],
+    by_side: bool,
+    first: &dyn Fn(VertexId) -> bool,
+    weight: &dyn Fn(VertexId) -> f64,
+) -> TwoBranch {
     let n = mesh.n_vertices();
     let allowed = |v: VertexId| !corners.contains(&v) && !mesh.is_boundary_vertex(v);
     let mut labels: Vec<Label> = Vec::new();
@@ -351,7 +389,7 @@ fn two_branch_dijkstra(mesh: &Mesh, corners: &[VertexId], mask: &[u64], by_side:
     for (ci, &corner) in corners.iter().enumerate() {
         let fan: Vec<VertexId> = mesh.vertex_neighbors(corner).collect();
         for (w, e) in neighbors_with_edges(mesh, corner) {
-            if !allowed(w) {
+            if !allowed(w) || !first(w) {
                 continue;
             }
             let d = mesh.edge_length(e);
@@ -387,7 +425,7 @@ fn two_branch_dijkstra(mesh: &Mesh, corners: &[VertexId], mask: &[u64], by_side:
             if !allowed(w) || of[w.idx()].len() >= 2 || of[w.idx()].iter().any(|&o| labels[o as usize].branch == br) {
                 continue;
             }
-            let nd = d + mesh.edge_length(e);
+            let nd = d + mesh.edge_length(e) * weight(w);
             // Keep a tentative label only if it beats the one of the same branch.
             if let Some(&t) = best[w.idx()].iter().find(|&&t| labels[t as usize].branch == br)
                 && labels[t as usize].dist <= nd
@@ -412,7 +450,11 @@ fn two_branch_dijkstra(mesh: &Mesh, corners: &[VertexId], mask: &[u64], by_side:
 pub fn interior_path(mesh: &Mesh, from: VertexId, to: &[VertexId]) -> Option<Vec<VertexId>> {
     let is_target = |v: VertexId| to.contains(&v);
     let allowed = |v: VertexId| is_target(v) || !mesh.is_boundary_vertex(v);
-    let (tree, hit) = dijkstra(mesh, &[from], &allowed, &is_target);
+    let mut ends = to.to_vec();
+    ends.push(from);
+    let near = near_boundary(mesh, &ends);
+    let weight = |w: VertexId| if near[w.idx()] { CLEARANCE } else { 1.0 };
+    let (tree, hit) = dijkstra(mesh, &[from], &allowed, &|_| true, &is_target, &weight);
     let hit = hit?;
     let p = path_to(&tree, hit);
     // A direct edge between two boundary copies would run along no interior: refuse.

@@ -197,11 +197,8 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
         let corners: Vec<VertexId> =
             (0..slit.mesh.n_vertices()).map(VertexId::from_idx).filter(|v| slit.orig[v.idx()] == corner).collect();
         let room = |lp: &[VertexId]| room_at_corner(mesh, corner, lp);
-        let first_slit = |_: VertexId| true;
         let weight_slit = |w: VertexId| weight(slit.orig[w.idx()]);
-        if let Some(lp) =
-            shortest_simple_loop(&slit, &corners, &emask, want, stem_len >= 2, &first_slit, &weight_slit, &room)
-        {
+        if let Some(lp) = shortest_simple_loop(&slit, &corners, &emask, want, stem_len >= 2, &weight_slit, &room) {
             out.push(lp);
         }
     }
@@ -216,12 +213,11 @@ fn shortest_simple_loop(
     mask: &[u64],
     want: u64,
     by_side: bool,
-    first: &dyn Fn(VertexId) -> bool,
     weight: &dyn Fn(VertexId) -> f64,
     room: &dyn Fn(&[VertexId]) -> bool,
 ) -> Option<Vec<VertexId>> {
     let mesh = &slit.mesh;
-    let two = two_branch_dijkstra(mesh, corners, mask, by_side, first, weight);
+    let two = two_branch_dijkstra(mesh, corners, mask, by_side, weight);
     let mut cands: Vec<(f64, u32, u32)> = Vec::new();
     for e in 0..mesh.n_edges() {
         let e = EdgeId::from_idx(e);
@@ -375,7 +371,6 @@ fn two_branch_dijkstra(
     corners: &[VertexId],
     mask: &[u64],
     by_side: bool,
-    first: &dyn Fn(VertexId) -> bool,
     weight: &dyn Fn(VertexId) -> f64,
 ) -> TwoBranch {
     let n = mesh.n_vertices();
@@ -389,7 +384,7 @@ fn two_branch_dijkstra(
     for (ci, &corner) in corners.iter().enumerate() {
         let fan: Vec<VertexId> = mesh.vertex_neighbors(corner).collect();
         for (w, e) in neighbors_with_edges(mesh, corner) {
-            if !allowed(w) || !first(w) {
+            if !allowed(w) {
                 continue;
             }
             let d = mesh.edge_length(e);

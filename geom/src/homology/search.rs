@@ -183,6 +183,15 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
                 continue;
             }
         }
+        if stem_len >= 2 {
+            let rb = return_beside(mesh, corner, &px, y, &coh.mask, want, &weight);
+            if let Some(lp) = rb
+                && room_at_corner(mesh, corner, &lp)
+            {
+                out.push(lp);
+                continue;
+            }
+        }
         let slit = if stem_len >= 2 {
             cut_along(mesh, &path_edges(mesh, &[px[..stem_len].to_vec()])?)?
         } else {
@@ -203,6 +212,44 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
         }
     }
     Ok(out)
+}
+
+/// A lasso's loop made simple: out along `out` (corner to `x`), across to `y`, and back to the
+/// corner by the shortest path that avoids `out` (keeping a vertex of clearance from it where it
+/// can), in class `want`.
+fn return_beside(
+    mesh: &Mesh,
+    corner: VertexId,
+    out: &[VertexId],
+    y: VertexId,
+    mask: &[u64],
+    want: u64,
+    weight: &dyn Fn(VertexId) -> f64,
+) -> Option<Vec<VertexId>> {
+    let n = mesh.n_vertices();
+    let mut on_out = vec![false; n];
+    for v in &out[1..] {
+        on_out[v.idx()] = true;
+    }
+    if on_out[y.idx()] || mesh.is_boundary_vertex(y) {
+        return None;
+    }
+    let mut beside = vec![false; n];
+    for v in &out[1..] {
+        for w in mesh.vertex_neighbors(*v) {
+            beside[w.idx()] = true;
+        }
+    }
+    let allowed = |v: VertexId| v == corner || (!on_out[v.idx()] && !mesh.is_boundary_vertex(v));
+    let w8 = |v: VertexId| if beside[v.idx()] && v != corner { CLEARANCE * weight(v) } else { weight(v) };
+    let (tree, hit) = dijkstra(mesh, &[y], &allowed, &|_| true, &|v| v == corner, &w8);
+    hit?;
+    // From the source `y` to the corner.
+    let back = path_to(&tree, corner);
+    let mut lp = out.to_vec();
+    lp.extend(back);
+    let class = lp.windows(2).try_fold(0u64, |acc, w| edge_between(mesh, w[0], w[1]).map(|e| acc ^ mask[e.idx()]))?;
+    (class == want).then_some(lp)
 }
 
 /// The shortest loop in class `want` on `slit` from a corner copy back to a corner copy, with

@@ -2,7 +2,7 @@
 //! intersection matrix is the standard symplectic form, the cut surface is a disk (χ = 1) and
 //! its boundary reads `a1 b1 a1⁻¹ b1⁻¹ … ag bg ag⁻¹ bg⁻¹`.
 
-use geom::homology::{CanonicalBasisOptions, canonical_basis};
+use geom::homology::{CanonicalBasisOptions, canonical_basis, fundamental_domain};
 use geom::io::{ReadOptions, read_path};
 use geom::mesh::{Mesh, VertexId};
 use geom::topology;
@@ -36,6 +36,10 @@ fn check(name: &str, genus: usize) {
     assert_eq!(topology::boundary_loops(&r.disk.mesh).len(), 1, "{name}: one boundary loop");
     assert_eq!(r.corners.len(), 4 * genus);
     assert_eq!(r.word_text(), canonical_word(genus), "{name}: boundary word");
+    // The disk on the regular 4g-gon: bijective, both copies of every cut vertex mirrored.
+    let d = fundamental_domain(&r).unwrap();
+    assert!(d.injectivity.is_injective(), "{name}: {:?}", d.injectivity);
+    assert!(d.residual < 1e-8, "{name}: residual {}", d.residual);
     // Every loop is simple, closed at the base, and meets the others only there.
     let mut owner = vec![usize::MAX; r.refined.mesh.n_vertices()];
     for (k, l) in r.loops.iter().enumerate() {

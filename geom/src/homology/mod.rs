@@ -7,12 +7,15 @@
 //! - [`search`]: shortest non-separating loops and side-to-side paths on a cut surface.
 //! - [`word`]: boundary words, the canonical rotation, intersection numbers at the base.
 //! - [`basis`]: the canonical basis itself.
+//! - [`domain`]: the cut disk on the regular 4g-gon.
 
 pub mod basis;
 pub mod cocycle;
 pub mod cut;
+pub mod domain;
 pub mod refine;
 pub mod search;
 pub mod word;
 
 pub use basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis};
+pub use domain::{FundamentalDomainResult, fundamental_domain};

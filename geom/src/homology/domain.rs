@@ -9,8 +9,8 @@
 use super::basis::CanonicalBasisResult;
 use crate::error::{Error, Result};
 use crate::linalg::{FixedBoundarySystem, Weights};
-use crate::mesh::VertexId;
 use crate::mesh::Mesh;
+use crate::mesh::VertexId;
 use crate::param::{InjectivityReport, Uv};
 
 /// The planar image of a cut disk.
@@ -70,7 +70,8 @@ pub fn domain_unchecked(basis: &CanonicalBasisResult) -> Result<FundamentalDomai
         for k in [4 * j, 4 * j + 1] {
             // Side k and its partner k + 2 (the same loop, read backwards).
             let s = side(k);
-            let len: Vec<f64> = s.windows(2).map(|w| (disk.position(walk[w[1]]) - disk.position(walk[w[0]])).norm()).collect();
+            let len: Vec<f64> =
+                s.windows(2).map(|w| (disk.position(walk[w[1]]) - disk.position(walk[w[0]])).norm()).collect();
             let total: f64 = len.iter().sum();
             let mut t = vec![0.0; s.len()];
             for i in 1..s.len() {

@@ -8,14 +8,17 @@
 //! - [`word`]: boundary words, the canonical rotation, intersection numbers at the base.
 //! - [`basis`]: the canonical basis itself.
 //! - [`domain`]: the cut disk on the regular 4g-gon.
+//! - [`map`]: maps both ways through the two domains, rotation τ, induced map on H1.
 
 pub mod basis;
 pub mod cocycle;
 pub mod cut;
 pub mod domain;
+pub mod map;
 pub mod refine;
 pub mod search;
 pub mod word;
 
 pub use basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis};
 pub use domain::{FundamentalDomainResult, fundamental_domain};
+pub use map::{HomologyMapOptions, HomologyMapResult, homology_map, rotation_count};

@@ -4,6 +4,7 @@
 
 mod artifacts;
 mod run;
+mod run_homology;
 mod spec;
 
 pub use run::{Artifact, MapReport, run_map};

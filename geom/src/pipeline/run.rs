@@ -37,11 +37,14 @@ pub struct MapReport {
     /// Milliseconds per stage.
     pub timings_ms: Vec<(String, f64)>,
     pub smoothing: smooth::SmoothReport,
+    /// `homology` jobs: bases, rotation and the induced map on H1.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub homology: Option<super::run_homology::HomologyReport>,
 }
 
-struct Clock(Instant, Vec<(String, f64)>);
+pub(super) struct Clock(pub(super) Instant, pub(super) Vec<(String, f64)>);
 impl Clock {
-    fn lap(&mut self, stage: &str) {
+    pub(super) fn lap(&mut self, stage: &str) {
         let now = Instant::now();
         self.1.push((stage.to_string(), (now - self.0).as_secs_f64() * 1e3));
         self.0 = now;
@@ -50,12 +53,37 @@ impl Clock {
 
 /// Runs `side` on a scoped thread while `main` runs here: the source and target halves of a
 /// stage are independent. The side half reports no progress (the main half does).
-fn both<A: Send, B>(side: impl FnOnce() -> A + Send, main: impl FnOnce() -> B) -> Result<(B, A)> {
+pub(super) fn both<A: Send, B>(side: impl FnOnce() -> A + Send, main: impl FnOnce() -> B) -> Result<(B, A)> {
     std::thread::scope(|sc| {
         let h = sc.spawn(side);
         let b = main();
         Ok((b, h.join().map_err(|_| Error::Internal("worker thread panicked".into()))?))
     })
+}
+
+/// One direction's last stages: stretch-reducing smoothing, visibility under the evaluator's
+/// rules, fold repair, re-embedding and metrics. Shared by every method.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn finish_direction(
+    from: &Mesh,
+    to: &Mesh,
+    map: SurfaceMap,
+    fixed: &[VertexId],
+    anchors: &[(VertexId, VertexId)],
+    o: &super::spec::MapOptions,
+    progress: &mut dyn Progress,
+    smoothed: &mut dyn FnMut(),
+) -> Result<(SurfaceMap, smooth::SmoothReport, Mesh, MapMetrics)> {
+    let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
+    let (mut m, r) = smooth::smooth(from, to, map, fixed, &o.smoothing, progress)?;
+    let v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
+    let repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
+    smoothed();
+    progress.check()?;
+    progress.report("metrics", 0.0);
+    let embedded = m.embed(from, to)?;
+    let metrics = evaluate_map(from, to, &embedded, Some(anchors), None, &mo)?;
+    Ok((m, smooth::SmoothReport { repaired, made_visible: v, ..r }, embedded, metrics))
 }
 
 /// The maps both ways, with what produced them.
@@ -75,6 +103,9 @@ pub fn run_map(
     target: &Mesh,
     progress: &mut dyn Progress,
 ) -> Result<(MapReport, Vec<Artifact>)> {
+    if spec.method == Method::Homology {
+        return super::run_homology::run_homology(spec, source, target, progress);
+    }
     let mut clock = Clock(Instant::now(), Vec::new());
     let pairs = spec.validate(source, target)?;
     let o = &spec.options;
@@ -98,6 +129,7 @@ pub fn run_map(
                 Ok(s)
             }),
             Method::Greedy => greedy::greedy_layout(&mut st, &mut tt, chi, &o.layout, progress),
+            Method::Homology => Err(Error::Internal("homology jobs do not build a layout".into())),
         };
         match built {
             Ok(mut s) => {
@@ -157,24 +189,14 @@ pub fn run_map(
     // The two directions are independent from here on: each thread smooths its map, makes it
     // visible to the evaluator's rules, embeds it and measures it, so the lighter direction's
     // metrics overlap the heavier direction's smoothing.
-    let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
-    let finish = |from: &Mesh,
-                  to: &Mesh,
-                  map: SurfaceMap,
-                  fixed: &[VertexId],
-                  anchors: &[(VertexId, VertexId)],
-                  progress: &mut dyn Progress,
-                  smoothed: &mut dyn FnMut()| {
-        let (mut m, r) = smooth::smooth(from, to, map, fixed, &o.smoothing, progress)?;
-        let v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
-        let repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
-        smoothed();
-        progress.check()?;
-        progress.report("metrics", 0.0);
-        let embedded = m.embed(from, to)?;
-        let metrics = evaluate_map(from, to, &embedded, Some(anchors), None, &mo)?;
-        Ok::<_, Error>((m, smooth::SmoothReport { repaired, made_visible: v, ..r }, embedded, metrics))
-    };
+    let finish =
+        |from: &Mesh,
+         to: &Mesh,
+         map: SurfaceMap,
+         fixed: &[VertexId],
+         anchors: &[(VertexId, VertexId)],
+         progress: &mut dyn Progress,
+         smoothed: &mut dyn FnMut()| { finish_direction(from, to, map, fixed, anchors, o, progress, smoothed) };
     let (a, b) = both(
         || finish(target, source, t2s, &ta, &rev, &mut crate::progress::NoProgress, &mut || {}),
         || finish(source, target, s2t, &sa, &pairs, progress, &mut || clock.lap("smooth")),
@@ -194,6 +216,7 @@ pub fn run_map(
         target_to_source: m2,
         timings_ms: Vec::new(),
         smoothing: r1.merge(r2),
+        homology: None,
     };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, &result, &on_target, &on_source)?;
     clock.lap("artifacts");

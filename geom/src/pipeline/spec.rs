@@ -17,6 +17,8 @@ pub enum Method {
     Voronoi,
     /// The shortest-paths-first heuristic of Kraevoy & Sheffer 2004.
     Greedy,
+    /// Canonical homology bases and the 4g-gon domain (Carner, Jin, Gu, Qin 2005).
+    Homology,
 }
 
 impl Method {
@@ -24,6 +26,7 @@ impl Method {
         match self {
             Method::Voronoi => "voronoi",
             Method::Greedy => "greedy",
+            Method::Homology => "homology",
         }
     }
 }
@@ -40,6 +43,10 @@ pub struct MapOptions {
     pub smoothing: SmoothOptions,
     /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
     pub metric_samples: usize,
+    /// `homology`: basis index (0 = shortest) on the source and on the target.
+    pub basis: [usize; 2],
+    /// `homology`: τ rotates the source's 4g-gon by `rotation · 2π/g` (quarter turns for g = 1).
+    pub rotation: usize,
 }
 
 impl Default for MapOptions {
@@ -49,6 +56,8 @@ impl Default for MapOptions {
             param: PatchParamOptions::default(),
             smoothing: SmoothOptions::default(),
             metric_samples: 100_000,
+            basis: [0, 0],
+            rotation: 0,
         }
     }
 }
@@ -135,10 +144,22 @@ impl JobSpec {
         if n > MAX_ANCHORS {
             return Err(InputError::Anchors(format!("{n} anchors exceed the limit {MAX_ANCHORS}")).into());
         }
-        let need = if ss.genus == 0 { 3 } else { 6 };
+        let need = match (self.method, ss.genus) {
+            (Method::Homology, 0) => {
+                return Err(InputError::TopologyMismatch(
+                    "method homology needs genus >= 1 (feature curves that would add handles to a genus-0 surface are not supported yet)".into(),
+                )
+                .into());
+            }
+            // The base vertex of both canonical bases.
+            (Method::Homology, _) => 1,
+            (_, 0) => 3,
+            _ => 6,
+        };
         if n < need {
             return Err(InputError::Anchors(format!(
-                "too few anchors: {n} given, a genus-{} layout needs at least {need}",
+                "too few anchors: {n} given, method {} on genus {} needs at least {need}",
+                self.method.name(),
                 ss.genus
             ))
             .into());

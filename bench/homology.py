@@ -1,0 +1,79 @@
+#!/usr/bin/env python3
+"""Method `homology` on same-shape cases (known correspondence) and different shapes: every
+rotation τ of the 4g-gon, judged by ../shared/eval/meshmetrics.py.
+
+usage: python3 bench/homology.py [path/to/surfmap] [filter]
+"""
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import table2  # noqa: E402  (case builders)
+
+mm = table2.mm
+np = table2.np
+M = table2.M
+
+
+def run(binary, tmp, s, t, anchors, gt, rotation, basis=(0, 0)):
+    spec = os.path.join(tmp, "spec.json")
+    json.dump({"method": "homology", "anchors": anchors,
+               "options": {"rotation": rotation, "basis": list(basis)}}, open(spec, "w"))
+    out = os.path.join(tmp, "out")
+    times = []
+    for _ in range(1):
+        t0 = time.perf_counter()
+        p = subprocess.run([binary, "map", s, t, "--spec", spec, "--out", out], capture_output=True, text=True)
+        times.append(time.perf_counter() - t0)
+        if p.returncode != 0:
+            return {"error": p.stderr.strip().splitlines()[-1]}
+    S, T, MP = mm.load_mesh(s), mm.load_mesh(t), mm.load_mesh(os.path.join(out, "source_on_target.obj"))
+    g = T[0][np.loadtxt(gt, dtype=np.int64)] if gt else None
+    e = mm.evaluate_map(S, T, MP, anchors, g, samples=100000)
+    rep = json.load(open(os.path.join(out, "metrics.json")))
+    e["time"] = statistics.median(times)
+    e["h1"] = rep["homology"]["h1"]
+    e["rev_flips"] = rep["target_to_source"]["flipped_faces"]
+    return e
+
+
+def main():
+    binary = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
+        os.environ.get("CARGO_TARGET_DIR", os.path.join(HERE, "..", "target")), "release", "surfmap")
+    filt = sys.argv[2] if len(sys.argv) > 2 else ""
+    cases = [
+        ("torus twisted (g1)", "torus.obj", "twist", 1),
+        ("torus shuffled (g1)", "torus.obj", "shuffle", 1),
+        ("kitten twisted (g1)", "kitten.nf20k.off", "twist", 1),
+        ("rocker arm bent (g1)", "rocker_arm/rocker-arm.obj", "bend", 1),
+        ("eight bent (g2)", "eight.off", "bend", 2),
+        ("eight_lowres shuffled (g2)", "eight_lowres.off", "shuffle", 2),
+        ("genus3 twisted (g3)", "genus3.off", "twist", 3),
+        ("3holes bent (g3)", "3holes.off", "bend", 3),
+    ]
+    with tempfile.TemporaryDirectory() as tmp:
+        print("| case | rotation | time s | flips s→t/t→s | area | L2 | E_ang | anchor | gt mean | H1 |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+        for name, path, kind, g in cases:
+            if filt not in name:
+                continue
+            s, t, anchors, gt = table2.same_shape(tmp, name.split()[0], os.path.join(M, path), kind, int(os.environ.get("ANCHORS", "1")))
+            for rot in range(4 if g == 1 else g):
+                e = run(binary, tmp, s, t, anchors, gt, rot)
+                if "error" in e:
+                    print(f"| {name} | {rot} | — | {e['error']} |")
+                    continue
+                print(f"| {name} | {rot} | {e['time']:.2f} | {e['flipped_faces']}/{e['rev_flips']} | "
+                      f"{e['area_ratio']:.4f} | {e['l2_stretch']:.4f} | {e['angle_distortion']:.3f} | "
+                      f"{e['anchor_error_max']:.1e} | {e.get('gt_error_mean', float('nan')):.4f} | {e['h1']} |")
+                sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()

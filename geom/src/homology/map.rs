@@ -1,0 +1,153 @@
+//! Maps between two surfaces of one genus through their fundamental domains (Carner et al.
+//! eq. 2): every vertex of one mesh is located, after the rotation τ, in the other's planar
+//! 4g-gon, and its barycentric coordinates there become a point of the other's original mesh.
+//! The homotopy class is chosen by the basis index on each mesh and by τ; the induced map on
+//! H1 is reported as an integer matrix computed from intersection numbers.
+
+use super::basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis};
+use super::domain::{FundamentalDomainResult, fundamental_domain};
+use crate::crossparam::locate2d::Grid;
+use crate::error::{InputError, Result};
+use crate::map::SurfaceMap;
+use crate::mesh::{FaceId, Mesh, VertexId};
+use crate::param::Uv;
+use serde::{Deserialize, Serialize};
+
+/// Options for [`homology_map`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct HomologyMapOptions {
+    /// Basis index (0 = shortest) on the source and on the target.
+    pub basis: [usize; 2],
+    /// τ: rotate the source domain by `rotation · 2π/g` (a quarter turn per step for g = 1).
+    pub rotation: usize,
+    /// Subdivision rounds allowed while looking for disjoint loops.
+    pub max_subdivisions: Option<usize>,
+}
+
+/// One side's basis and domain.
+#[derive(Debug, Clone)]
+pub struct SideDomain {
+    pub basis: CanonicalBasisResult,
+    pub domain: FundamentalDomainResult,
+}
+
+/// Maps both ways and what produced them.
+#[derive(Debug, Clone)]
+pub struct HomologyMapResult {
+    pub source_to_target: SurfaceMap,
+    pub target_to_source: SurfaceMap,
+    /// Induced map on H1: column `j` is the image of source loop `j` in the target basis
+    /// (`a1, b1, …`).
+    pub h1: Vec<Vec<i32>>,
+    /// Polygon sides τ shifts by.
+    pub side_shift: usize,
+    pub source: SideDomain,
+    pub target: SideDomain,
+}
+
+/// Number of distinct rotations τ: `g`, or 4 quarter turns for the torus.
+pub fn rotation_count(genus: usize) -> usize {
+    if genus == 1 { 4 } else { genus }
+}
+
+/// Basis and domain of one mesh through `base`.
+///
+/// # Errors
+/// As [`canonical_basis`] and [`fundamental_domain`].
+pub fn side_domain(mesh: &Mesh, base: VertexId, index: usize, max_subdivisions: Option<usize>) -> Result<SideDomain> {
+    let mut o = CanonicalBasisOptions { basis_index: index, ..Default::default() };
+    if let Some(m) = max_subdivisions {
+        o.max_subdivisions = m;
+    }
+    let basis = canonical_basis(mesh, base, &o)?;
+    let domain = fundamental_domain(&basis)?;
+    Ok(SideDomain { basis, domain })
+}
+
+/// Maps `source` and `target` through canonical bases at `bases = (source vertex, target vertex)`.
+///
+/// # Errors
+/// `InvalidInput` on genus mismatch; as [`side_domain`].
+pub fn homology_map(
+    source: &Mesh,
+    target: &Mesh,
+    bases: (VertexId, VertexId),
+    opts: &HomologyMapOptions,
+) -> Result<HomologyMapResult> {
+    let (s, t) = std::thread::scope(|sc| {
+        let h = sc.spawn(|| side_domain(target, bases.1, opts.basis[1], opts.max_subdivisions));
+        let s = side_domain(source, bases.0, opts.basis[0], opts.max_subdivisions);
+        (s, h.join())
+    });
+    let s = s?;
+    let t = t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??;
+    map_between(source, target, s, t, opts.rotation)
+}
+
+/// Composes two sides' domains under rotation `rotation`.
+///
+/// # Errors
+/// `InvalidInput` when the genera differ.
+pub fn map_between(
+    source: &Mesh,
+    target: &Mesh,
+    s: SideDomain,
+    t: SideDomain,
+    rotation: usize,
+) -> Result<HomologyMapResult> {
+    let g = s.basis.genus();
+    if g != t.basis.genus() {
+        return Err(InputError::TopologyMismatch(format!("source genus {g}, target genus {}", t.basis.genus())).into());
+    }
+    let m = 4 * g;
+    let shift = if g == 1 { rotation % 4 } else { 4 * (rotation % g) };
+    let angle = std::f64::consts::TAU * shift as f64 / m as f64;
+    let rot = |p: Uv, a: f64| [p[0] * a.cos() - p[1] * a.sin(), p[0] * a.sin() + p[1] * a.cos()];
+    let source_to_target = locate_all(source, &s, &t, &|p| rot(p, angle));
+    let target_to_source = locate_all(target, &t, &s, &|p| rot(p, -angle));
+    let h1 = induced_h1(&s.basis, &t.basis, shift);
+    Ok(HomologyMapResult { source_to_target, target_to_source, h1, side_shift: shift, source: s, target: t })
+}
+
+/// Every original vertex of `from` (through one of its disk copies) located in `to`'s domain.
+fn locate_all(from: &Mesh, fs: &SideDomain, ts: &SideDomain, tau: &dyn Fn(Uv) -> Uv) -> SurfaceMap {
+    let disk = &fs.basis.disk;
+    let mut copy = vec![u32::MAX; from.n_vertices()];
+    for (d, o) in disk.orig.iter().enumerate() {
+        if o.idx() < copy.len() && copy[o.idx()] == u32::MAX {
+            copy[o.idx()] = d as u32;
+        }
+    }
+    let tris = ts.basis.disk.mesh.face_indices();
+    let grid = Grid::new(&ts.domain.uv, &tris);
+    let mut face = Vec::with_capacity(from.n_vertices());
+    let mut bary = Vec::with_capacity(from.n_vertices());
+    for &c in &copy {
+        let p = tau(fs.domain.uv[c as usize]);
+        let (f, b) = grid.locate(&ts.domain.uv, &tris, p);
+        let (of, ob) = ts.basis.refined.to_original(FaceId(f), b);
+        face.push(of);
+        bary.push(ob);
+    }
+    SurfaceMap { face, bary }
+}
+
+/// The induced map on H1 in the two canonical bases: source side `k` lands on target side
+/// `k + shift`; the image's coordinates come from its intersection numbers with the target
+/// basis (`x_j = γ·b_j`, `y_j = −γ·a_j`, since `a_j·b_j = 1`).
+fn induced_h1(s: &CanonicalBasisResult, t: &CanonicalBasisResult, shift: usize) -> Vec<Vec<i32>> {
+    let n = s.loops.len();
+    let m = t.word.len();
+    let mut h = vec![vec![0; n]; n];
+    for (j, col) in (0..n).map(|j| (j, 4 * (j / 2) + j % 2)) {
+        let letter = t.word[(col + shift) % m];
+        let sign = i32::from(letter.dir);
+        let row = &t.intersection[letter.loop_id];
+        for i in 0..n / 2 {
+            h[2 * i][j] = sign * row[2 * i + 1];
+            h[2 * i + 1][j] = -sign * row[2 * i];
+        }
+    }
+    h
+}

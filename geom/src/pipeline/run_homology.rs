@@ -1,0 +1,182 @@
+//! `run_homology`: canonical bases -> fundamental domains -> maps through the 4g-gon -> anchor
+//! snapping -> smoothing -> metrics -> artifacts (bases and domains included).
+
+use super::run::{Artifact, Clock, MapReport, both, finish_direction};
+use super::spec::JobSpec;
+use crate::domain::LayoutStats;
+use crate::error::{Error, Result};
+use crate::homology::{HomologyMapOptions, homology_map, map::SideDomain};
+use crate::io::{self, Format};
+use crate::map::SurfaceMap;
+use crate::mesh::{FaceId, Mesh, P3, VertexId};
+use crate::progress::{NoProgress, Progress};
+use serde::Serialize;
+use serde_json::json;
+use std::time::Instant;
+
+/// What a `homology` job adds to `metrics.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct HomologyReport {
+    pub genus: usize,
+    pub basis: [usize; 2],
+    pub rotation: usize,
+    /// Polygon sides τ shifts by.
+    pub side_shift: usize,
+    /// Induced map on H1 (`a1, b1, …`), column `j` the image of source loop `j`.
+    pub h1: Vec<Vec<i32>>,
+    /// Base vertices (the first anchor pair).
+    pub base: [u32; 2],
+    /// Subdivision rounds the bases needed.
+    pub subdivisions: [usize; 2],
+    /// Loop lengths on each mesh.
+    pub loop_lengths: [Vec<f64>; 2],
+}
+
+/// A point exactly at vertex `v` of `mesh`.
+fn at_vertex(mesh: &Mesh, v: VertexId) -> (FaceId, [f64; 3]) {
+    let h = mesh.outgoing(v).next().map(|h| (h.face(), h.corner()));
+    let (f, c) = h.unwrap_or((FaceId(0), 0));
+    let mut b = [0.0; 3];
+    b[c] = 1.0;
+    (f, b)
+}
+
+/// Runs a `homology` job.
+///
+/// # Errors
+/// As [`super::run_map`].
+pub fn run_homology(
+    spec: &JobSpec,
+    source: &Mesh,
+    target: &Mesh,
+    progress: &mut dyn Progress,
+) -> Result<(MapReport, Vec<Artifact>)> {
+    let mut clock = Clock(Instant::now(), Vec::new());
+    let pairs = spec.validate(source, target)?;
+    let o = &spec.options;
+    clock.lap("setup");
+    progress.report("basis", 0.0);
+    let hopts = HomologyMapOptions { basis: o.basis, rotation: o.rotation, max_subdivisions: None };
+    let r = homology_map(source, target, pairs[0], &hopts)?;
+    clock.lap("basis_domain_map");
+    progress.check()?;
+    // Anchors beyond the base pair are placed exactly; smoothing then relaxes around them.
+    let (mut s2t, mut t2s) = (r.source_to_target.clone(), r.target_to_source.clone());
+    for &(s, t) in &pairs {
+        let (f, b) = at_vertex(target, t);
+        s2t.face[s.idx()] = f;
+        s2t.bary[s.idx()] = b;
+        let (f, b) = at_vertex(source, s);
+        t2s.face[t.idx()] = f;
+        t2s.bary[t.idx()] = b;
+    }
+    let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).collect();
+    let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).collect();
+    let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
+    progress.report("smooth", 0.0);
+    let (a, b) = both(
+        || finish_direction(target, source, t2s, &ta, &rev, o, &mut NoProgress, &mut || {}),
+        || finish_direction(source, target, s2t, &sa, &pairs, o, progress, &mut || {}),
+    )?;
+    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = (a?, b?);
+    clock.lap("smooth_metrics");
+    progress.check()?;
+    let g = r.source.basis.genus();
+    let len = |sd: &SideDomain| -> Vec<f64> {
+        let m = &sd.basis.refined.mesh;
+        sd.basis
+            .loops
+            .iter()
+            .map(|l| l.windows(2).map(|w| (m.position(w[1]) - m.position(w[0])).norm()).sum())
+            .collect()
+    };
+    let report = HomologyReport {
+        genus: g,
+        basis: o.basis,
+        rotation: o.rotation,
+        side_shift: r.side_shift,
+        h1: r.h1.clone(),
+        base: [pairs[0].0.0, pairs[0].1.0],
+        subdivisions: [r.source.basis.subdivisions, r.target.basis.subdivisions],
+        loop_lengths: [len(&r.source), len(&r.target)],
+    };
+    let mut arts = common_artifacts(&s2t, &t2s, &on_target, &on_source);
+    arts.push(json_artifact("basis_source.json", &basis_json(&r.source))?);
+    arts.push(json_artifact("basis_target.json", &basis_json(&r.target))?);
+    arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });
+    arts.push(Artifact { name: "domain_target.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.target)? });
+    clock.lap("artifacts");
+    let mut report = MapReport {
+        method: spec.method.name(),
+        anchors: pairs.len(),
+        patches: 1,
+        source_vertices: source.n_vertices(),
+        target_vertices: target.n_vertices(),
+        layout: LayoutStats::default(),
+        source_to_target: m1,
+        target_to_source: m2,
+        timings_ms: Vec::new(),
+        smoothing: r1.merge(r2),
+        homology: Some(report),
+    };
+    let total: f64 = clock.1.iter().map(|x| x.1).sum();
+    clock.1.push(("total".into(), total));
+    report.timings_ms = clock.1;
+    arts.push(json_artifact(
+        "metrics.json",
+        &serde_json::to_value(&report).map_err(|e| Error::Internal(e.to_string()))?,
+    )?);
+    progress.report("done", 1.0);
+    Ok((report, arts))
+}
+
+fn json_artifact(name: &str, v: &serde_json::Value) -> Result<Artifact> {
+    let bytes = serde_json::to_vec_pretty(v).map_err(|e| Error::Internal(e.to_string()))?;
+    Ok(Artifact { name: name.into(), content_type: "application/json", bytes })
+}
+
+fn common_artifacts(s2t: &SurfaceMap, t2s: &SurfaceMap, on_target: &Mesh, on_source: &Mesh) -> Vec<Artifact> {
+    let ((obj_t, obj_s), (csv_st, csv_ts)) = rayon::join(
+        || rayon::join(|| io::write(on_target, Format::Obj), || io::write(on_source, Format::Obj)),
+        || rayon::join(|| s2t.to_csv(), || t2s.to_csv()),
+    );
+    vec![
+        Artifact { name: "source_on_target.obj".into(), content_type: "model/obj", bytes: obj_t },
+        Artifact { name: "target_on_source.obj".into(), content_type: "model/obj", bytes: obj_s },
+        Artifact { name: "source_to_target.csv".into(), content_type: "text/csv", bytes: csv_st.into_bytes() },
+        Artifact { name: "target_to_source.csv".into(), content_type: "text/csv", bytes: csv_ts.into_bytes() },
+    ]
+}
+
+/// Loops as 3D polylines (a1, b1, …), with vertex ids where they are original vertices, the
+/// intersection matrix and the boundary word.
+fn basis_json(sd: &SideDomain) -> serde_json::Value {
+    let b = &sd.basis;
+    let m = &b.refined.mesh;
+    let loops: Vec<_> = b
+        .loops
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            let name = format!("{}{}", if i % 2 == 0 { 'a' } else { 'b' }, i / 2 + 1);
+            let pts: Vec<[f64; 3]> = l.iter().map(|&v| m.position(v)).map(|p| [p.x, p.y, p.z]).collect();
+            json!({"name": name, "points": pts})
+        })
+        .collect();
+    json!({
+        "genus": b.genus(),
+        "base_vertex": b.base.0,
+        "loops": loops,
+        "intersection": b.intersection,
+        "word": b.word_text(),
+        "subdivisions": b.subdivisions,
+        "disk_euler_characteristic": crate::topology::euler_characteristic(&b.disk.mesh),
+    })
+}
+
+/// The planar 4g-gon as a mesh at z = 0.
+fn domain_obj(sd: &SideDomain) -> Result<Vec<u8>> {
+    let pos: Vec<P3> = sd.domain.uv.iter().map(|p| P3::new(p[0], p[1], 0.0)).collect();
+    let m = Mesh::from_triangles(pos, &sd.basis.disk.mesh.face_indices())?;
+    Ok(io::write(&m, Format::Obj))
+}

@@ -65,3 +65,19 @@ fn inconsistent_anchors() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("[invalid_anchors]") && err.contains("repeat target vertex 100"), "{err}");
 }
+
+#[test]
+fn homology_refusals() {
+    // Genus 0 without feature curves has no homology basis.
+    let (code, err) = run_map("cow.off", "cow.off", r#"{"method": "homology", "anchors": [[0,0]]}"#, "hom0");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[topology_mismatch]") && err.contains("genus"), "{err}");
+    // The base vertex is the first anchor: none given.
+    let (code, err) = run_map("torus.obj", "torus.obj", r#"{"method": "homology", "anchors": []}"#, "hom1");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[invalid_anchors]") && err.contains("too few anchors"), "{err}");
+    // Genus mismatch.
+    let (code, err) = run_map("torus.obj", "eight_lowres.off", r#"{"method": "homology", "anchors": [[0,0]]}"#, "hom2");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("genus mismatch"), "{err}");
+}

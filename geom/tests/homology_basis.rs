@@ -3,17 +3,11 @@
 //! its boundary reads `a1 b1 a1⁻¹ b1⁻¹ … ag bg ag⁻¹ bg⁻¹`.
 
 use geom::homology::{CanonicalBasisOptions, canonical_basis, fundamental_domain};
-use geom::io::{ReadOptions, read_path};
-use geom::mesh::{Mesh, VertexId};
+use geom::mesh::VertexId;
 use geom::topology;
-use std::path::PathBuf;
 
-fn load(name: &str) -> Mesh {
-    let root = std::env::var_os("SURFMAP_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared"));
-    read_path(&root.join("meshes").join(name), &ReadOptions::default()).unwrap().mesh
-}
+mod common;
+use common::load;
 
 fn canonical_word(g: usize) -> String {
     (1..=g).map(|i| format!("a{i} b{i} a{i}^-1 b{i}^-1")).collect::<Vec<_>>().join(" ")

@@ -1,75 +1,14 @@
 //! End-to-end invariants of the `voronoi` and `greedy` pipelines on real meshes from
 //! `../shared/meshes`, with the true correspondence known: a shuffled copy and a twisted copy.
 
-use geom::io::{ReadOptions, read_path};
-use geom::mesh::{Mesh, P3, VertexId};
+use geom::io::ReadOptions;
+
+mod common;
+use common::{fps, load, shuffled, twisted};
+use geom::mesh::{Mesh, VertexId};
 use geom::pipeline::{JobSpec, MapOptions, Method, run_map};
 use geom::progress::NoProgress;
 use geom::topology::Locator;
-use std::path::PathBuf;
-
-fn shared(name: &str) -> PathBuf {
-    let root = std::env::var_os("SURFMAP_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared"));
-    root.join("meshes").join(name)
-}
-
-fn load(name: &str) -> Mesh {
-    read_path(&shared(name), &ReadOptions::default()).unwrap().mesh
-}
-
-/// Euclidean farthest-point sampling from vertex 0.
-fn fps(m: &Mesh, k: usize) -> Vec<u32> {
-    let p = m.positions();
-    let mut d: Vec<f64> = p.iter().map(|x| (x - p[0]).norm()).collect();
-    let mut out = vec![0u32];
-    while out.len() < k {
-        let i = (0..p.len()).max_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap();
-        out.push(i as u32);
-        for (j, x) in p.iter().enumerate() {
-            d[j] = d[j].min((x - p[i]).norm());
-        }
-    }
-    out
-}
-
-/// A copy with vertices in another order; returns it and new index of each old vertex.
-fn shuffled(m: &Mesh) -> (Mesh, Vec<u32>) {
-    let n = m.n_vertices() as u64;
-    // A fixed permutation: multiplication by a unit modulo n.
-    let mut a = 7919u64;
-    while gcd(a, n) != 1 {
-        a += 2;
-    }
-    let perm: Vec<u32> = (0..n).map(|i| ((i * a + 13) % n) as u32).collect();
-    let mut pos = vec![P3::origin(); n as usize];
-    for (i, &p) in perm.iter().enumerate() {
-        pos[p as usize] = m.positions()[i];
-    }
-    let faces: Vec<[u32; 3]> = m.faces().iter().map(|f| f.map(|v| perm[v.idx()])).collect();
-    (Mesh::from_triangles(pos, &faces).unwrap(), perm)
-}
-
-fn gcd(a: u64, b: u64) -> u64 {
-    if b == 0 { a } else { gcd(b, a % b) }
-}
-
-/// A copy twisted about its vertical axis (up to 0.8 rad), same vertex order.
-fn twisted(m: &Mesh) -> Mesh {
-    let (lo, hi) = m.bbox();
-    let c = P3::from((lo.coords + hi.coords) / 2.0);
-    let pos = m
-        .positions()
-        .iter()
-        .map(|p| {
-            let t = (p.y - lo.y) / (hi.y - lo.y) * 0.8;
-            let (x, z) = (p.x - c.x, p.z - c.z);
-            P3::new(c.x + x * t.cos() - z * t.sin(), p.y, c.z + x * t.sin() + z * t.cos())
-        })
-        .collect();
-    m.with_positions(pos).unwrap()
-}
 
 struct Checked {
     l2: f64,

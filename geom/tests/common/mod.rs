@@ -3,6 +3,7 @@
 
 use geom::Mesh;
 use geom::io::{ReadOptions, read_path};
+use geom::mesh::P3;
 use std::path::{Path, PathBuf};
 
 pub fn shared_mesh(name: &str) -> PathBuf {
@@ -16,4 +17,78 @@ pub fn shared_mesh(name: &str) -> PathBuf {
 
 pub fn load(name: &str) -> Mesh {
     read_path(&shared_mesh(name), &ReadOptions::default()).expect("read shared mesh").mesh
+}
+
+/// Euclidean farthest-point sampling from vertex 0.
+pub fn fps(m: &Mesh, k: usize) -> Vec<u32> {
+    let p = m.positions();
+    let mut d: Vec<f64> = p.iter().map(|x| (x - p[0]).norm()).collect();
+    let mut out = vec![0u32];
+    while out.len() < k {
+        let i = (0..p.len()).max_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap();
+        out.push(i as u32);
+        for (j, x) in p.iter().enumerate() {
+            d[j] = d[j].min((x - p[i]).norm());
+        }
+    }
+    out
+}
+
+/// A copy with vertices in another order; returns it and new index of each old vertex.
+pub fn shuffled(m: &Mesh) -> (Mesh, Vec<u32>) {
+    let n = m.n_vertices() as u64;
+    // A fixed permutation: multiplication by a unit modulo n.
+    let mut a = 7919u64;
+    while gcd(a, n) != 1 {
+        a += 2;
+    }
+    let perm: Vec<u32> = (0..n).map(|i| ((i * a + 13) % n) as u32).collect();
+    let mut pos = vec![P3::origin(); n as usize];
+    for (i, &p) in perm.iter().enumerate() {
+        pos[p as usize] = m.positions()[i];
+    }
+    let faces: Vec<[u32; 3]> = m.faces().iter().map(|f| f.map(|v| perm[v.idx()])).collect();
+    (Mesh::from_triangles(pos, &faces).unwrap(), perm)
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
+/// A copy twisted about its vertical axis (up to 0.8 rad), same vertex order.
+pub fn twisted(m: &Mesh) -> Mesh {
+    let (lo, hi) = m.bbox();
+    let c = P3::from((lo.coords + hi.coords) / 2.0);
+    let pos = m
+        .positions()
+        .iter()
+        .map(|p| {
+            let t = (p.y - lo.y) / (hi.y - lo.y) * 0.8;
+            let (x, z) = (p.x - c.x, p.z - c.z);
+            P3::new(c.x + x * t.cos() - z * t.sin(), p.y, c.z + x * t.sin() + z * t.cos())
+        })
+        .collect();
+    m.with_positions(pos).unwrap()
+}
+
+/// A copy bent along its longest axis (the evaluator-bench "bend"), same vertex order.
+pub fn bent(m: &Mesh) -> Mesh {
+    let (lo, hi) = m.bbox();
+    let d = hi - lo;
+    let ax = (0..3).max_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap_or(0);
+    let o = (ax + 1) % 3;
+    let c = (lo.coords + hi.coords) / 2.0;
+    let r = d[ax] * 1.2;
+    let pos = m
+        .positions()
+        .iter()
+        .map(|p| {
+            let u = (p[ax] - c[ax]) / r;
+            let mut q = *p;
+            q[ax] = c[ax] + r * u.sin();
+            q[o] = p[o] + r * (1.0 - u.cos());
+            q
+        })
+        .collect();
+    m.with_positions(pos).unwrap()
 }

@@ -1,0 +1,110 @@
+//! Method `homology` end to end on same-shape pairs with known correspondence: among the
+//! homotopy classes (rotations τ, basis choices) the true one maps with 0 flips, exact anchors
+//! and a small ground-truth error; other rotations give other H1 matrices.
+
+use geom::io::ReadOptions;
+use geom::mesh::{Mesh, VertexId};
+use geom::pipeline::{JobSpec, MapOptions, MapReport, Method, run_map};
+use geom::progress::NoProgress;
+use geom::topology::Locator;
+
+mod common;
+use common::{bent, load, shuffled};
+
+struct Run {
+    report: MapReport,
+    gt_mean: f64,
+}
+
+fn run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, basis: [usize; 2]) -> Run {
+    let spec = JobSpec {
+        method: Method::Homology,
+        anchors: anchors.iter().map(|&a| [a as u64, gt[a as usize] as u64]).collect(),
+        options: MapOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
+    };
+    let (report, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();
+    let names: Vec<&str> = arts.iter().map(|a| a.name.as_str()).collect();
+    for n in [
+        "source_on_target.obj",
+        "target_on_source.obj",
+        "source_to_target.csv",
+        "target_to_source.csv",
+        "basis_source.json",
+        "basis_target.json",
+        "domain_source.obj",
+        "domain_target.obj",
+        "metrics.json",
+    ] {
+        assert!(names.contains(&n), "missing {n}");
+    }
+    let obj = arts.iter().find(|a| a.name == "source_on_target.obj").unwrap();
+    let mapped = geom::io::read(&obj.bytes, &ReadOptions::default()).unwrap().mesh;
+    assert_eq!(mapped.faces(), s.faces(), "equal connectivity");
+    let loc = Locator::new(t).unwrap();
+    let off = mapped.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
+    assert!(off <= 1e-9 * t.bbox_diagonal(), "off surface {off}");
+    let gt_mean =
+        mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(gt[i]))).norm()).sum::<f64>()
+            / mapped.n_vertices() as f64
+            / t.area().sqrt();
+    Run { report, gt_mean }
+}
+
+fn assert_clean(r: &Run, what: &str) {
+    for m in [&r.report.source_to_target, &r.report.target_to_source] {
+        assert_eq!(m.flipped_faces, 0, "{what}: flips {m:?}");
+        assert!(m.anchor_error_max.unwrap() <= 1e-9, "{what}: anchors {m:?}");
+        assert!((0.97..=1.03).contains(&m.area_ratio), "{what}: area {m:?}");
+    }
+    assert!(r.gt_mean <= 0.05, "{what}: ground-truth error {}", r.gt_mean);
+}
+
+fn h1(r: &Run) -> Vec<Vec<i32>> {
+    r.report.homology.as_ref().unwrap().h1.clone()
+}
+
+#[test]
+fn torus_shuffled_every_rotation_is_another_class() {
+    let s = load("torus.obj");
+    let (t, gt) = shuffled(&s);
+    let runs: Vec<Run> = (0..4).map(|k| run(&s, &t, &gt, &[0], k, [0, 0])).collect();
+    assert_clean(&runs[0], "rotation 0");
+    assert!(runs[0].gt_mean < 1e-9, "the identity class is exact: {}", runs[0].gt_mean);
+    // Four quarter turns: four different induced maps on H1, the identity among them.
+    assert_eq!(h1(&runs[0]), vec![vec![1, 0], vec![0, 1]]);
+    for i in 0..4 {
+        for j in 0..i {
+            assert_ne!(h1(&runs[i]), h1(&runs[j]), "rotations {i} and {j}");
+        }
+        assert!(runs[i].gt_mean > 0.1 || i == 0, "rotation {i} is not the true class");
+    }
+}
+
+#[test]
+fn kitten_bent_genus_one() {
+    let s = load("kitten.nf20k.off");
+    let t = bent(&s);
+    let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let r = run(&s, &t, &gt, &[0], 0, [0, 0]);
+    assert_clean(&r, "kitten bent");
+}
+
+#[test]
+fn eight_lowres_shuffled_genus_two() {
+    let s = load("eight_lowres.off");
+    let (t, gt) = shuffled(&s);
+    let r0 = run(&s, &t, &gt, &[0], 0, [0, 0]);
+    assert_clean(&r0, "eight_lowres");
+    let r1 = run(&s, &t, &gt, &[0], 1, [0, 0]);
+    assert_ne!(h1(&r0), h1(&r1), "the half turn swaps the handles");
+}
+
+#[test]
+fn three_holes_bent_genus_three() {
+    let s = load("3holes.off");
+    let t = bent(&s);
+    let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let r = run(&s, &t, &gt, &[0], 0, [0, 0]);
+    assert_clean(&r, "3holes bent");
+    assert_eq!(r.report.homology.as_ref().unwrap().genus, 3);
+}

@@ -31,7 +31,7 @@ fn check(name: &str, genus: usize) {
     assert_eq!(r.corners.len(), 4 * genus);
     assert_eq!(r.word_text(), canonical_word(genus), "{name}: boundary word");
     // The disk on the regular 4g-gon: bijective, both copies of every cut vertex mirrored.
-    let d = fundamental_domain(&r).unwrap();
+    let d = fundamental_domain(&r, 0).unwrap();
     assert!(d.injectivity.is_injective(), "{name}: {:?}", d.injectivity);
     assert!(d.residual < 1e-8, "{name}: residual {}", d.residual);
     // Every loop is simple, closed at the base, and meets the others only there.

@@ -8,10 +8,10 @@
 
 use super::basis::CanonicalBasisResult;
 use crate::error::{Error, Result};
-use crate::linalg::{FixedBoundarySystem, Weights};
+use crate::linalg::{FixedBoundarySystem, Weights, directed_weights};
 use crate::mesh::Mesh;
 use crate::mesh::VertexId;
-use crate::param::{InjectivityReport, Uv};
+use crate::param::{InjectivityReport, StretchOptions, Uv, minimize_stretch};
 
 /// The planar image of a cut disk.
 #[derive(Debug, Clone)]
@@ -36,8 +36,8 @@ pub fn polygon_corner(m: usize, k: usize) -> Uv {
 ///
 /// # Errors
 /// `Numerical` when the solve fails or the result folds; `Internal` for a malformed basis.
-pub fn fundamental_domain(basis: &CanonicalBasisResult) -> Result<FundamentalDomainResult> {
-    let r = domain_unchecked(basis)?;
+pub fn fundamental_domain(basis: &CanonicalBasisResult, stretch_iterations: usize) -> Result<FundamentalDomainResult> {
+    let r = domain_unchecked(basis, stretch_iterations)?;
     if !r.injectivity.is_injective() {
         return Err(Error::Numerical(format!(
             "fundamental domain: {} flipped and {} degenerate triangles",
@@ -51,7 +51,7 @@ pub fn fundamental_domain(basis: &CanonicalBasisResult) -> Result<FundamentalDom
 ///
 /// # Errors
 /// As [`fundamental_domain`], except for folds.
-pub fn domain_unchecked(basis: &CanonicalBasisResult) -> Result<FundamentalDomainResult> {
+pub fn domain_unchecked(basis: &CanonicalBasisResult, stretch_iterations: usize) -> Result<FundamentalDomainResult> {
     let disk = &basis.disk.mesh;
     let walk = &basis.walk;
     let corners = &basis.corners;
@@ -94,8 +94,19 @@ pub fn domain_unchecked(basis: &CanonicalBasisResult) -> Result<FundamentalDomai
     }
     let boundary: Vec<VertexId> = walk.clone();
     let mut sys = FixedBoundarySystem::new(disk, &boundary)?;
-    let factor = sys.factor(disk, Weights::MeanValue)?;
-    let (uv, residual) = factor.solve_with_residual::<2>(&|v| fixed[v.idx()])?;
+    sys.prepare_lu()?;
+    let w = directed_weights(disk, Weights::MeanValue);
+    let (uv, residual) = sys.factor_weights(&w, false)?.solve_with_residual::<2>(&|v| fixed[v.idx()])?;
+    // The harmonic map squeezes whatever lies far from the cut; Yoshizawa-Belyaev-Seidel
+    // reweighting (positive weights, so still bijective) spreads it out again.
+    let (uv, residual) = if stretch_iterations > 0 {
+        let so = StretchOptions { iterations: stretch_iterations, ..Default::default() };
+        let r = minimize_stretch(disk, &sys, &w, uv, &|v| fixed[v.idx()], &so)?;
+        let res = if r.rounds > 0 { r.residual } else { residual };
+        (r.uv, res)
+    } else {
+        (uv, residual)
+    };
     let injectivity = exact_orientation(disk, &uv);
     Ok(FundamentalDomainResult { uv, polygon, injectivity, residual })
 }

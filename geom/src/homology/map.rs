@@ -23,6 +23,8 @@ pub struct HomologyMapOptions {
     pub rotation: usize,
     /// Subdivision rounds allowed while looking for disjoint loops.
     pub max_subdivisions: Option<usize>,
+    /// Stretch-minimizing reweighting rounds of each domain map.
+    pub stretch_iterations: usize,
 }
 
 /// One side's basis and domain.
@@ -55,13 +57,19 @@ pub fn rotation_count(genus: usize) -> usize {
 ///
 /// # Errors
 /// As [`canonical_basis`] and [`fundamental_domain`].
-pub fn side_domain(mesh: &Mesh, base: VertexId, index: usize, max_subdivisions: Option<usize>) -> Result<SideDomain> {
+pub fn side_domain(
+    mesh: &Mesh,
+    base: VertexId,
+    index: usize,
+    max_subdivisions: Option<usize>,
+    stretch_iterations: usize,
+) -> Result<SideDomain> {
     let mut o = CanonicalBasisOptions { basis_index: index, ..Default::default() };
     if let Some(m) = max_subdivisions {
         o.max_subdivisions = m;
     }
     let basis = canonical_basis(mesh, base, &o)?;
-    let domain = fundamental_domain(&basis)?;
+    let domain = fundamental_domain(&basis, stretch_iterations)?;
     Ok(SideDomain { basis, domain })
 }
 
@@ -76,8 +84,9 @@ pub fn homology_map(
     opts: &HomologyMapOptions,
 ) -> Result<HomologyMapResult> {
     let (s, t) = std::thread::scope(|sc| {
-        let h = sc.spawn(|| side_domain(target, bases.1, opts.basis[1], opts.max_subdivisions));
-        let s = side_domain(source, bases.0, opts.basis[0], opts.max_subdivisions);
+        let h =
+            sc.spawn(|| side_domain(target, bases.1, opts.basis[1], opts.max_subdivisions, opts.stretch_iterations));
+        let s = side_domain(source, bases.0, opts.basis[0], opts.max_subdivisions, opts.stretch_iterations);
         (s, h.join())
     });
     let s = s?;

@@ -1,0 +1,59 @@
+//! Method `homology`: the canonical basis of botijo (41k vertices, genus 5) and of fertility
+//! (genus 4), and a whole genus-1 job on 10k-vertex meshes (the kitten against a bent copy of
+//! itself, base vertex 0), as `surfmap map` runs it.
+//! `cargo bench -p surfmap-geom --bench homology`
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use geom::homology::{CanonicalBasisOptions, canonical_basis};
+use geom::io::{ReadOptions, read_path};
+use geom::mesh::{Mesh, P3, VertexId};
+use geom::pipeline::{JobSpec, MapOptions, Method, run_map};
+use geom::progress::NoProgress;
+use std::path::PathBuf;
+
+fn load(name: &str) -> Mesh {
+    let p = std::env::var_os("SURFMAP_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared"))
+        .join("meshes")
+        .join(name);
+    read_path(&p, &ReadOptions::default()).expect("shared mesh").mesh
+}
+
+/// Bent along y (the kitten's long axis is irrelevant for timing).
+fn bent(m: &Mesh) -> Mesh {
+    let (lo, hi) = m.bbox();
+    let r = (hi.y - lo.y) * 1.2;
+    let cy = (lo.y + hi.y) / 2.0;
+    let pos = m
+        .positions()
+        .iter()
+        .map(|p| {
+            let u = (p.y - cy) / r;
+            P3::new(p.x, cy + r * u.sin(), p.z + r * (1.0 - u.cos()))
+        })
+        .collect();
+    m.with_positions(pos).expect("same faces")
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("homology");
+    g.sample_size(10);
+    for name in ["botijo.off", "genus3.off", "kitten.nf20k.off"] {
+        let m = load(name);
+        let o = CanonicalBasisOptions::default();
+        if canonical_basis(&m, VertexId(0), &o).is_err() {
+            eprintln!("{name}: no canonical basis through vertex 0 (known gap), not timed");
+            continue;
+        }
+        g.bench_function(format!("basis_{name}"), |b| b.iter(|| canonical_basis(&m, VertexId(0), &o).expect("basis")));
+    }
+    let s = load("kitten.nf20k.off");
+    let t = bent(&s);
+    let spec = JobSpec { method: Method::Homology, anchors: vec![[0, 0]], options: MapOptions::default() };
+    g.bench_function("kitten_bent_genus1_map", |b| b.iter(|| run_map(&spec, &s, &t, &mut NoProgress).expect("map")));
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

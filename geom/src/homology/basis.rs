@@ -105,15 +105,24 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
     let g = s.genus as usize;
     let mut refined = Refined::identity(mesh).raise_valence(base, 8 * g + 8)?;
     for round in 0..=opts.max_subdivisions {
-        // A crowded base vertex first gets more edges (twice, then four times as many).
+        // A crowded base vertex first gets more edges (twice, then four times as many); loops
+        // that pen the corner in (neighbouring loop vertices joined by an edge) get those
+        // edges split, which opens an interior vertex between them.
         let mut local = refined.clone();
-        for extra in 0..3 {
-            if let Ok(loops) = search(&local.mesh, base, g, opts.basis_index)? {
-                return finish(local, base, loops, round);
-            }
+        for extra in 0..5 {
+            let partial = match search(&local.mesh, base, g, opts.basis_index)? {
+                Ok(loops) => return finish(local, base, loops, round),
+                Err(partial) => partial,
+            };
             if extra < 2 {
                 let valence = local.mesh.outgoing(base).count();
                 local = local.raise_valence(base, 2 * valence)?;
+            } else {
+                let chords = chords_of(&local.mesh, &partial);
+                if chords.is_empty() {
+                    break;
+                }
+                local = local.split_edges(&chords)?;
             }
         }
         if round < opts.max_subdivisions {
@@ -130,67 +139,99 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
 }
 
 /// Handle by handle on the surface cut so far; `None` when loops would have to touch.
-type Loops = Vec<Vec<VertexId>>;
-/// A finished basis, or the loops found before the search got stuck.
-type Searched = std::result::Result<Loops, Loops>;
-
-/// `Ok(Err(partial))`: the search got stuck; `partial` holds the loops found so far (the
-/// one being crossed included), whose chords the caller splits before trying again.
-fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<Searched> {
+/// Handle by handle on the surface cut so far; `None` when loops would have to touch.
+/// Each handle tries the corners between commutators (most reachable interior first) and, at
+/// each, the shortest few non-separating classes, until one admits its crossing loop.
+fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<std::result::Result<Loops, Loops>> {
     let mut s = CutMesh { mesh: mesh.clone(), orig: (0..mesh.n_vertices()).map(VertexId::from_idx).collect() };
-    let mut corner = base;
+    let mut corners = vec![base];
     let mut loops: Vec<Vec<VertexId>> = Vec::with_capacity(2 * g);
     for handle in 0..g {
-        let skip = if handle == 0 { first } else { 0 };
-        let cands = nonseparating_loops(&s.mesh, corner, skip + 1)?;
-        let Some(a) = cands.into_iter().nth(skip) else {
-            debug(&format!("handle {handle}: no non-separating loop at the corner"));
-            return Ok(Err(Vec::new()));
-        };
-        let s1 = compose(&s, cut_along(&s.mesh, &path_edges(&s.mesh, std::slice::from_ref(&a))?)?);
-        let local: Vec<VertexId> = copies_of(&s1, &s, corner);
-        if local.len() < 2 {
-            debug(&format!("handle {handle}: corner has {} copies after cutting a", local.len()));
-            return Ok(Err(loops));
-        }
-        // From the copy between a's two ends to a copy on either outer side.
-        let from = if handle == 0 {
-            local[0]
-        } else {
-            match middle_copy(&s1, &s, &local) {
-                Some(m) => m,
-                None => {
-                    debug(&format!("handle {handle}: no middle copy among {}", local.len()));
-                    return Ok(Err(loops));
+        let mut done = None;
+        'corners: for &corner in &corners {
+            let (skip, count) = if handle == 0 { (first, first + 1) } else { (0, 3) };
+            let cands = nonseparating_loops(&s.mesh, corner, count)?;
+            let n_cands = cands.len();
+            for a in cands.into_iter().skip(skip) {
+                if let Some(step) = cross(&s, corner, &a, handle == 0)? {
+                    done = Some(step);
+                    break 'corners;
                 }
             }
-        };
-        let to: Vec<VertexId> = local.iter().copied().filter(|&c| c != from).collect();
-        let Some(b) = interior_path(&s1.mesh, from, &to) else {
-            debug(&format!("handle {handle}: no path from one side of a to the other"));
-            loops.push(a.iter().map(|&v| s.orig[v.idx()]).collect());
-            return Ok(Err(loops));
-        };
-        let s2 = compose(&s1, cut_along(&s1.mesh, &path_edges(&s1.mesh, std::slice::from_ref(&b))?)?);
+            debug(&format!(
+                "handle {handle}: no loop pair at corner {} ({n_cands} loops, fan {}, interior {})",
+                corner.0,
+                s.mesh.outgoing(corner).count(),
+                reachable_interior(&s.mesh, corner)
+            ));
+        }
+        let Some((a, b, s1_orig_b, s2)) = done else { return Ok(Err(loops)) };
         loops.push(a.iter().map(|&v| s.orig[v.idx()]).collect());
-        loops.push(b.iter().map(|&v| s1.orig[v.idx()]).collect());
+        loops.push(b.iter().map(|&v| s1_orig_b[v.idx()]).collect());
         let Some(w) = read_word(&s2.mesh, &s2.orig, base, &loops) else {
             debug(&format!("handle {handle}: cut surface word unreadable"));
             return Ok(Err(loops));
         };
-        // Any corner between commutators will do: take the one that reaches the most interior
-        // (loops that run side by side can pen a corner into a small pocket), then the widest.
-        let Some(c) = canonical_rotations(&w.letters)
-            .into_iter()
-            .map(|r| w.walk[w.corners[r]])
-            .max_by_key(|&c| (reachable_interior(&s2.mesh, c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0)))
-        else {
+        // Any corner between commutators will do: most reachable interior first (loops that
+        // run side by side can pen a corner into a small pocket), then the widest.
+        corners = canonical_rotations(&w.letters).into_iter().map(|r| w.walk[w.corners[r]]).collect();
+        if corners.is_empty() {
             return Err(Error::Internal(format!("basis: handle {} left a non-canonical word", handle + 1)));
-        };
-        corner = c;
+        }
+        corners.sort_by_key(|&c| {
+            std::cmp::Reverse((reachable_interior(&s2.mesh, c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0)))
+        });
         s = s2;
     }
     Ok(Ok(loops))
+}
+
+type Loops = Vec<Vec<VertexId>>;
+
+/// Edges that are not on the loops but join two of their vertices.
+fn chords_of(mesh: &Mesh, loops: &[Vec<VertexId>]) -> Vec<[VertexId; 2]> {
+    let mut on = vec![false; mesh.n_vertices()];
+    for l in loops {
+        for v in l {
+            on[v.idx()] = true;
+        }
+    }
+    let Ok(cut) = path_edges(mesh, loops) else { return Vec::new() };
+    (0..mesh.n_edges())
+        .filter(|&e| !cut[e])
+        .map(|e| mesh.edge_vertices(crate::mesh::EdgeId::from_idx(e)))
+        .filter(|[a, b]| on[a.idx()] && on[b.idx()])
+        .collect()
+}
+
+/// Cuts `a` (a loop at `corner` of `s`) and looks for `b` from one side of it to the other.
+/// Returns `a`, `b` (in the ids of `s` and of the intermediate cut), that cut's `orig`, and the
+/// surface cut along both.
+#[allow(clippy::type_complexity)]
+fn cross(
+    s: &CutMesh,
+    corner: VertexId,
+    a: &[VertexId],
+    interior: bool,
+) -> Result<Option<(Vec<VertexId>, Vec<VertexId>, Vec<VertexId>, CutMesh)>> {
+    let s1 = compose(s, cut_along(&s.mesh, &path_edges(&s.mesh, &[a.to_vec()])?)?);
+    let local: Vec<VertexId> = copies_of(&s1, s, corner);
+    if local.len() < 2 {
+        return Ok(None);
+    }
+    // From the copy between a's two ends to a copy on either outer side.
+    let from = if interior {
+        local[0]
+    } else {
+        match middle_copy(&s1, s, &local) {
+            Some(m) => m,
+            None => return Ok(None),
+        }
+    };
+    let to: Vec<VertexId> = local.iter().copied().filter(|&c| c != from).collect();
+    let Some(b) = interior_path(&s1.mesh, from, &to) else { return Ok(None) };
+    let s2 = compose(&s1, cut_along(&s1.mesh, &path_edges(&s1.mesh, std::slice::from_ref(&b))?)?);
+    Ok(Some((a.to_vec(), b, s1.orig, s2)))
 }
 
 /// Interior vertices reachable from `corner` through interior vertices.

@@ -124,7 +124,17 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
         if mesh.is_boundary_vertex(corner) && fan.len() >= 4 { vec![fan[1], fan[fan.len() - 2]] } else { Vec::new() };
     let first_ok = |w: VertexId| !hugging.contains(&w);
     let near = near_boundary(mesh, &[corner]);
-    let weight = |w: VertexId| if near[w.idx()] { CLEARANCE } else { 1.0 };
+    // At a boundary corner, leaving near the middle of its fan keeps the outer sectors wide:
+    // they become the corners of the next handles.
+    let mut fan_cost = vec![1.0; mesh.n_vertices()];
+    if mesh.is_boundary_vertex(corner) && fan.len() >= 3 {
+        let half = (fan.len() - 1) as f64 / 2.0;
+        for (i, w) in fan.iter().enumerate() {
+            let q = (i.min(fan.len() - 1 - i) as f64 / half).min(1.0);
+            fan_cost[w.idx()] = 1.0 + 4.0 * (1.0 - q) * (1.0 - q);
+        }
+    }
+    let weight = |w: VertexId| if near[w.idx()] { CLEARANCE * fan_cost[w.idx()] } else { 1.0 };
     let (tree, _) = dijkstra(mesh, &[corner], &allowed, &first_ok, &|_| false, &weight);
     let n = mesh.n_vertices();
     let mut tree_edges: Vec<EdgeId> = Vec::with_capacity(n + 16);

@@ -110,7 +110,15 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
         // edges split, which opens an interior vertex between them.
         let mut local = refined.clone();
         for extra in 0..5 {
-            let partial = match search(&local.mesh, base, g, opts.basis_index)? {
+            let t0 = std::time::Instant::now();
+            let res = search(&local.mesh, base, g, opts.basis_index)?;
+            debug(&format!(
+                "attempt round {round} extra {extra}: {} vertices, {:.2} s, {}",
+                local.mesh.n_vertices(),
+                t0.elapsed().as_secs_f64(),
+                if res.is_ok() { "found" } else { "stuck" }
+            ));
+            let partial = match res {
                 Ok(loops) => return finish(local, base, loops, round),
                 Err(partial) => partial,
             };

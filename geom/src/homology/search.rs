@@ -30,6 +30,9 @@ impl Ord for Item {
 /// the paths that must cross or follow them later.
 const CLEARANCE: f64 = 3.0;
 
+/// Classes tried beyond the number of loops asked for.
+const MAX_EXTRA_CLASSES: usize = 3;
+
 /// Interior vertices with a boundary neighbour other than `except`.
 fn near_boundary(mesh: &Mesh, except: &[VertexId]) -> Vec<bool> {
     (0..mesh.n_vertices())
@@ -174,7 +177,9 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
     let mut seen = std::collections::HashSet::new();
     let mut out = Vec::new();
     for (_, e) in lassos {
-        if out.len() >= count {
+        // Classes beyond the shortest few are long detours; trying them all costs a slit and a
+        // search each on a failing corner.
+        if out.len() >= count || seen.len() >= count + MAX_EXTRA_CLASSES {
             break;
         }
         let want = coh.mask[e.idx()];
@@ -318,7 +323,10 @@ fn shortest_simple_loop(
         n_room += 1;
     }
     if dbg {
-        eprintln!("homology basis: {nc} loop candidates, {n_touch} touching, {n_room} without room");
+        let both = two.of.iter().filter(|o| o.len() == 2).count();
+        eprintln!(
+            "homology basis: {nc} loop candidates, {n_touch} touching, {n_room} without room, {both} labelled twice"
+        );
     }
     None
 }

@@ -108,3 +108,37 @@ fn three_holes_bent_genus_three() {
     assert_clean(&r, "3holes bent");
     assert_eq!(r.report.homology.as_ref().unwrap().genus, 3);
 }
+
+/// The meta-mesh pair: one face list, every vertex on its own surface, the surfaces' topology.
+fn check_meta(s: &Mesh, t: &Mesh, anchors: &[[u64; 2]], what: &str) {
+    let spec = JobSpec {
+        method: Method::Homology,
+        anchors: anchors.to_vec(),
+        options: MapOptions { metric_samples: 2000, meta_mesh: true, ..Default::default() },
+    };
+    let (report, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();
+    let stats = report.homology.as_ref().unwrap().meta_mesh.clone().unwrap();
+    assert!(stats.error.is_none(), "{what}: {stats:?}");
+    let get = |n: &str| {
+        let a = arts.iter().find(|a| a.name == n).unwrap_or_else(|| panic!("{what}: missing {n}"));
+        geom::io::read(&a.bytes, &ReadOptions::default()).unwrap().mesh
+    };
+    let (ms, mt) = (get("meta_source.obj"), get("meta_target.obj"));
+    assert_eq!(ms.faces(), mt.faces(), "{what}: shared faces");
+    assert!(ms.n_vertices() >= s.n_vertices().max(t.n_vertices()), "{what}: {} meta vertices", ms.n_vertices());
+    assert_eq!(geom::topology::euler_characteristic(&ms), geom::topology::euler_characteristic(s), "{what}: χ");
+    for (m, surf) in [(&ms, s), (&mt, t)] {
+        let loc = Locator::new(surf).unwrap();
+        let off = m.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
+        assert!(off <= 1e-9 * surf.bbox_diagonal(), "{what}: off surface {off}");
+    }
+}
+
+#[test]
+fn meta_mesh_kitten_bent_and_torus_pair() {
+    let s = load("kitten.nf20k.off");
+    check_meta(&s, &bent(&s), &[[0, 0]], "kitten bent");
+    let a = load("rocker_arm/rocker-arm2500.off");
+    let b = load("torus.obj");
+    check_meta(&a, &b, &[[0, 0]], "rocker arm / torus");
+}

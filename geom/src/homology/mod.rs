@@ -9,12 +9,14 @@
 //! - [`basis`]: the canonical basis itself.
 //! - [`domain`]: the cut disk on the regular 4g-gon.
 //! - [`map`]: maps both ways through the two domains, rotation τ, induced map on H1.
+//! - [`overlay`]: the meta-mesh, both tessellations merged.
 
 pub mod basis;
 pub mod cocycle;
 pub mod cut;
 pub mod domain;
 pub mod map;
+pub mod overlay;
 pub mod refine;
 pub mod search;
 pub mod word;

@@ -30,6 +30,19 @@ pub struct HomologyReport {
     pub subdivisions: [usize; 2],
     /// Loop lengths on each mesh.
     pub loop_lengths: [Vec<f64>; 2],
+    /// Meta-mesh vertices, faces and edge crossings, when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub meta_mesh: Option<MetaMeshStats>,
+}
+
+/// Size of the meta-mesh (or why it could not be built).
+#[derive(Debug, Clone, Serialize)]
+pub struct MetaMeshStats {
+    pub vertices: usize,
+    pub faces: usize,
+    pub crossings: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
 }
 
 /// A point exactly at vertex `v` of `mesh`.
@@ -106,8 +119,35 @@ pub fn run_homology(
         base: [pairs[0].0.0, pairs[0].1.0],
         subdivisions: [r.source.basis.subdivisions, r.target.basis.subdivisions],
         loop_lengths: [len(&r.source), len(&r.target)],
+        meta_mesh: None,
     };
     let mut arts = common_artifacts(&s2t, &t2s, &on_target, &on_source);
+    let mut meta = None;
+    if o.meta_mesh {
+        progress.report("meta_mesh", 0.0);
+        let angle = std::f64::consts::TAU * r.side_shift as f64 / (4 * g) as f64;
+        let m = crate::homology::overlay::meta_mesh(&r.source, &r.target, angle)?;
+        let mut stats =
+            MetaMeshStats { vertices: m.on_source.len(), faces: m.faces.len(), crossings: m.crossings, error: None };
+        match m.meshes() {
+            Ok((ms, mt)) => {
+                arts.push(Artifact {
+                    name: "meta_source.obj".into(),
+                    content_type: "model/obj",
+                    bytes: io::write(&ms, Format::Obj),
+                });
+                arts.push(Artifact {
+                    name: "meta_target.obj".into(),
+                    content_type: "model/obj",
+                    bytes: io::write(&mt, Format::Obj),
+                });
+            }
+            Err(e) => stats.error = Some(e.to_string()),
+        }
+        meta = Some(stats);
+        clock.lap("meta_mesh");
+    }
+    let report = HomologyReport { meta_mesh: meta, ..report };
     arts.push(json_artifact("basis_source.json", &basis_json(&r.source))?);
     arts.push(json_artifact("basis_target.json", &basis_json(&r.target))?);
     arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });

@@ -47,6 +47,8 @@ pub struct MapOptions {
     pub basis: [usize; 2],
     /// `homology`: τ rotates the source's 4g-gon by `rotation · 2π/g` (quarter turns for g = 1).
     pub rotation: usize,
+    /// `homology`: also merge both tessellations into the meta-mesh pair.
+    pub meta_mesh: bool,
 }
 
 impl Default for MapOptions {
@@ -58,6 +60,7 @@ impl Default for MapOptions {
             metric_samples: 100_000,
             basis: [0, 0],
             rotation: 0,
+            meta_mesh: false,
         }
     }
 }

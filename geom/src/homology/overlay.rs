@@ -1,0 +1,255 @@
+//! The meta-mesh (Carner et al. section 4, after Lee et al. 1999): both tessellations overlaid
+//! in the shared 4g-gon. Every source triangle is clipped against the target triangles it
+//! overlaps (Sutherland–Hodgman, convex against convex); each non-empty piece is a convex
+//! polygon whose corners are source vertices, target vertices or crossings of a source edge with
+//! a target edge, named symbolically so that neighbouring pieces share them. Pieces are fanned
+//! into triangles; copies of a vertex on the two sides of a cut loop are glued through the
+//! vertex they copy. The result has one face list and two vertex positions per meta-vertex:
+//! on the source (barycentric in the source triangle it lies in) and on the target.
+
+use super::map::SideDomain;
+use crate::error::{Error, Result};
+use crate::mesh::{Mesh, P3, VertexId};
+use crate::param::Uv;
+use std::collections::HashMap;
+
+/// The merged tessellation.
+#[derive(Debug, Clone)]
+pub struct MetaMeshResult {
+    pub faces: Vec<[u32; 3]>,
+    /// Per meta-vertex: position on the source surface.
+    pub on_source: Vec<P3>,
+    /// Per meta-vertex: position on the target surface.
+    pub on_target: Vec<P3>,
+    /// Meta-vertices that are crossings of a source edge with a target edge.
+    pub crossings: usize,
+}
+
+impl MetaMeshResult {
+    /// The two meshes (same faces).
+    ///
+    /// # Errors
+    /// `Numerical` when the overlay is not a valid manifold mesh.
+    pub fn meshes(&self) -> Result<(Mesh, Mesh)> {
+        let s = Mesh::from_triangles(self.on_source.clone(), &self.faces)
+            .map_err(|e| Error::Numerical(format!("meta-mesh on the source: {e}")))?;
+        let t = Mesh::from_triangles(self.on_target.clone(), &self.faces)
+            .map_err(|e| Error::Numerical(format!("meta-mesh on the target: {e}")))?;
+        Ok((s, t))
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Key {
+    /// A vertex of the source / target refinement (copies across a cut are one vertex).
+    S(u32),
+    T(u32),
+    /// Source edge (refined vertex pair) crossing target edge.
+    X([u32; 2], [u32; 2]),
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Support {
+    /// Source disk edge (disk vertex ids).
+    Src(u32, u32),
+    /// Target disk edge.
+    Tgt(u32, u32),
+}
+
+#[derive(Debug, Clone, Copy)]
+struct PV {
+    p: Uv,
+    key: Key,
+    /// Support of the edge that starts here.
+    next: Support,
+}
+
+fn cross(a: Uv, b: Uv, c: Uv) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// Overlays the source's domain (turned by `angle`) and the target's.
+///
+/// # Errors
+/// `Numerical` when a piece cannot be placed.
+pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshResult> {
+    let (ds, dt) = (&s.basis.disk, &t.basis.disk);
+    let (ca, sa) = (angle.cos(), angle.sin());
+    let us: Vec<Uv> = s.domain.uv.iter().map(|p| [p[0] * ca - p[1] * sa, p[0] * sa + p[1] * ca]).collect();
+    let ut = &t.domain.uv;
+    let tt = dt.mesh.face_indices();
+    let st = ds.mesh.face_indices();
+    // Bucket grid over target triangles.
+    let n = tt.len().max(1);
+    let cells = (n as f64).sqrt().ceil() as usize;
+    let (lo, hi) = ([-1.0f64, -1.0f64], [1.0f64, 1.0f64]);
+    let cw = (hi[0] - lo[0]) / cells as f64;
+    let cell_of = |x: f64, k: usize| (((x - lo[k]) / cw).floor().max(0.0) as usize).min(cells - 1);
+    let mut grid: Vec<Vec<u32>> = vec![Vec::new(); cells * cells];
+    for (f, tri) in tt.iter().enumerate() {
+        let ps = tri.map(|v| ut[v as usize]);
+        let (x0, x1) =
+            (ps.iter().map(|p| p[0]).fold(f64::MAX, f64::min), ps.iter().map(|p| p[0]).fold(f64::MIN, f64::max));
+        let (y0, y1) =
+            (ps.iter().map(|p| p[1]).fold(f64::MAX, f64::min), ps.iter().map(|p| p[1]).fold(f64::MIN, f64::max));
+        for y in cell_of(y0, 1)..=cell_of(y1, 1) {
+            for x in cell_of(x0, 0)..=cell_of(x1, 0) {
+                grid[y * cells + x].push(f as u32);
+            }
+        }
+    }
+    let eps = 1e-12;
+    let so = |v: u32| ds.orig[v as usize].0;
+    let to = |v: u32| dt.orig[v as usize].0;
+    let pair = |a: u32, b: u32| if a < b { [a, b] } else { [b, a] };
+    let mut ids: HashMap<Key, u32> = HashMap::new();
+    let mut on_source: Vec<P3> = Vec::new();
+    let mut on_target: Vec<P3> = Vec::new();
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    let mut crossings = 0;
+    let mut stamp = vec![u32::MAX; tt.len()];
+    let bary = |tri: [Uv; 3], p: Uv| {
+        let d = cross(tri[0], tri[1], tri[2]);
+        let l1 = cross(tri[0], p, tri[2]) / d;
+        let l2 = cross(tri[0], tri[1], p) / d;
+        [1.0 - l1 - l2, l1, l2].map(|x| x.clamp(0.0, 1.0))
+    };
+    let point = |m: &Mesh, tri: [u32; 3], b: [f64; 3]| {
+        let s: f64 = b.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+        let mut acc = P3::origin().coords;
+        for k in 0..3 {
+            acc += m.position(VertexId(tri[k])).coords * (b[k] / s);
+        }
+        P3::from(acc)
+    };
+    for (sf, stri) in st.iter().enumerate() {
+        let sp = stri.map(|v| us[v as usize]);
+        let (x0, x1) =
+            (sp.iter().map(|p| p[0]).fold(f64::MAX, f64::min), sp.iter().map(|p| p[0]).fold(f64::MIN, f64::max));
+        let (y0, y1) =
+            (sp.iter().map(|p| p[1]).fold(f64::MAX, f64::min), sp.iter().map(|p| p[1]).fold(f64::MIN, f64::max));
+        for y in cell_of(y0, 1)..=cell_of(y1, 1) {
+            for x in cell_of(x0, 0)..=cell_of(x1, 0) {
+                for &tf in &grid[y * cells + x] {
+                    if stamp[tf as usize] == sf as u32 {
+                        continue;
+                    }
+                    stamp[tf as usize] = sf as u32;
+                    let ttri = tt[tf as usize];
+                    let tp = ttri.map(|v| ut[v as usize]);
+                    let mut poly: Vec<PV> = (0..3)
+                        .map(|k| PV {
+                            p: sp[k],
+                            key: Key::S(so(stri[k])),
+                            next: Support::Src(stri[k], stri[(k + 1) % 3]),
+                        })
+                        .collect();
+                    for j in 0..3 {
+                        let (qa, qb) = (tp[j], tp[(j + 1) % 3]);
+                        let len = ((qb[0] - qa[0]).powi(2) + (qb[1] - qa[1]).powi(2)).sqrt();
+                        if len == 0.0 {
+                            poly.clear();
+                            break;
+                        }
+                        let dist = |p: Uv| cross(qa, qb, p) / len;
+                        let te = (ttri[j], ttri[(j + 1) % 3]);
+                        let mut out = Vec::with_capacity(poly.len() + 2);
+                        for i in 0..poly.len() {
+                            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+                            let (da, db) = (dist(a.p), dist(b.p));
+                            let (ain, bin) = (da >= -eps, db >= -eps);
+                            if ain {
+                                if !bin && da.abs() <= eps {
+                                    out.push(PV { next: Support::Tgt(te.0, te.1), ..a });
+                                    continue;
+                                }
+                                out.push(a);
+                            }
+                            if ain != bin && da.abs() > eps && db.abs() > eps {
+                                let u = da / (da - db);
+                                let ip = [a.p[0] + (b.p[0] - a.p[0]) * u, a.p[1] + (b.p[1] - a.p[1]) * u];
+                                let key = match a.next {
+                                    Support::Tgt(x, y) => {
+                                        // Two target edges meet at their shared vertex.
+                                        let shared = [x, y].into_iter().find(|&v| v == te.0 || v == te.1);
+                                        shared.map_or(Key::T(to(te.0)), |v| Key::T(to(v)))
+                                    }
+                                    Support::Src(x, y) => {
+                                        // Along the target edge: snap to its ends.
+                                        let tl = ((ip[0] - qa[0]) * (qb[0] - qa[0])
+                                            + (ip[1] - qa[1]) * (qb[1] - qa[1]))
+                                            / (len * len);
+                                        if tl <= eps {
+                                            Key::T(to(te.0))
+                                        } else if tl >= 1.0 - eps {
+                                            Key::T(to(te.1))
+                                        } else if u <= eps {
+                                            a.key
+                                        } else if u >= 1.0 - eps {
+                                            b.key
+                                        } else {
+                                            Key::X(pair(so(x), so(y)), pair(to(te.0), to(te.1)))
+                                        }
+                                    }
+                                };
+                                let next = if ain { Support::Tgt(te.0, te.1) } else { a.next };
+                                out.push(PV { p: ip, key, next });
+                            }
+                        }
+                        poly = out;
+                        if poly.len() < 3 {
+                            break;
+                        }
+                    }
+                    // Drop repeated keys (snapped corners) and empty pieces.
+                    poly.dedup_by(|b, a| a.key == b.key);
+                    while poly.len() > 1 && poly[0].key == poly[poly.len() - 1].key {
+                        poly.pop();
+                    }
+                    if poly.len() < 3 {
+                        continue;
+                    }
+                    let area: f64 = (1..poly.len() - 1).map(|k| cross(poly[0].p, poly[k].p, poly[k + 1].p)).sum();
+                    if area <= 1e-24 {
+                        continue;
+                    }
+                    let mut vid = Vec::with_capacity(poly.len());
+                    for pv in &poly {
+                        let next_id = on_source.len() as u32;
+                        // The base vertex is a corner of both polygons: one meta-vertex.
+                        let key = if pv.key == Key::T(t.basis.base.0) { Key::S(s.basis.base.0) } else { pv.key };
+                        let id = *ids.entry(key).or_insert(next_id);
+                        if id == next_id {
+                            let ps = point(&ds.mesh, *stri, bary(sp, pv.p));
+                            let pt = point(&dt.mesh, ttri, bary(tp, pv.p));
+                            on_source.push(ps);
+                            on_target.push(pt);
+                            if matches!(key, Key::X(..)) {
+                                crossings += 1;
+                            }
+                        }
+                        vid.push(id);
+                    }
+                    for k in 1..vid.len() - 1 {
+                        if vid[0] != vid[k] && vid[k] != vid[k + 1] && vid[0] != vid[k + 1] {
+                            faces.push([vid[0], vid[k], vid[k + 1]]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Exact positions where the meta-vertex is an input vertex.
+    for (key, &id) in &ids {
+        match key {
+            Key::S(v) if *v == s.basis.base.0 => {
+                on_source[id as usize] = s.basis.refined.mesh.position(VertexId(*v));
+                on_target[id as usize] = t.basis.refined.mesh.position(t.basis.base);
+            }
+            Key::S(v) => on_source[id as usize] = s.basis.refined.mesh.position(VertexId(*v)),
+            Key::T(v) => on_target[id as usize] = t.basis.refined.mesh.position(VertexId(*v)),
+            Key::X(..) => {}
+        }
+    }
+    Ok(MetaMeshResult { faces, on_source, on_target, crossings })
+}

@@ -44,6 +44,8 @@ pub struct HomologyMapResult {
     pub h1: Vec<Vec<i32>>,
     /// Polygon sides τ shifts by.
     pub side_shift: usize,
+    /// Whether the source domain was warped to put the anchors on their partners.
+    pub warped: bool,
     pub source: SideDomain,
     pub target: SideDomain,
 }
@@ -81,6 +83,7 @@ pub fn homology_map(
     source: &Mesh,
     target: &Mesh,
     bases: (VertexId, VertexId),
+    anchors: &[(VertexId, VertexId)],
     opts: &HomologyMapOptions,
 ) -> Result<HomologyMapResult> {
     let (s, t) = std::thread::scope(|sc| {
@@ -91,7 +94,7 @@ pub fn homology_map(
     });
     let s = s?;
     let t = t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??;
-    map_between(source, target, s, t, opts.rotation)
+    map_between(source, target, s, t, opts.rotation, anchors)
 }
 
 /// Composes two sides' domains under rotation `rotation`.
@@ -101,9 +104,10 @@ pub fn homology_map(
 pub fn map_between(
     source: &Mesh,
     target: &Mesh,
-    s: SideDomain,
+    mut s: SideDomain,
     t: SideDomain,
     rotation: usize,
+    anchors: &[(VertexId, VertexId)],
 ) -> Result<HomologyMapResult> {
     let g = s.basis.genus();
     if g != t.basis.genus() {
@@ -113,10 +117,57 @@ pub fn map_between(
     let shift = if g == 1 { rotation % 4 } else { 4 * (rotation % g) };
     let angle = std::f64::consts::TAU * shift as f64 / m as f64;
     let rot = |p: Uv, a: f64| [p[0] * a.cos() - p[1] * a.sin(), p[0] * a.sin() + p[1] * a.cos()];
+    let warped = warp_to_anchors(&mut s, &t, anchors, &|p| rot(p, -angle))?;
     let source_to_target = locate_all(source, &s, &t, &|p| rot(p, angle));
     let target_to_source = locate_all(target, &t, &s, &|p| rot(p, -angle));
     let h1 = induced_h1(&s.basis, &t.basis, shift);
-    Ok(HomologyMapResult { source_to_target, target_to_source, h1, side_shift: shift, source: s, target: t })
+    Ok(HomologyMapResult { source_to_target, target_to_source, h1, side_shift: shift, warped, source: s, target: t })
+}
+
+/// Anchors that are interior to both disks, as (source disk vertex, target disk vertex).
+fn interior_copies(s: &SideDomain, t: &SideDomain, anchors: &[(VertexId, VertexId)]) -> Vec<(VertexId, VertexId)> {
+    let copy = |sd: &SideDomain, v: VertexId| -> Option<VertexId> {
+        let d = &sd.basis.disk;
+        let mut it = d.orig.iter().enumerate().filter(|(_, o)| **o == v);
+        let (first, _) = it.next()?;
+        // A vertex with one copy that is not on the boundary lies off every cut loop.
+        let dv = VertexId::from_idx(first);
+        (it.next().is_none() && !d.mesh.is_boundary_vertex(dv)).then_some(dv)
+    };
+    anchors.iter().filter_map(|&(a, b)| Some((copy(s, a)?, copy(t, b)?))).collect()
+}
+
+/// Re-solves the source domain with the anchors (those off the cut loops on both meshes) held
+/// where their partners lie in the target domain (mapped back by `untau`): the constrained
+/// mean-value map. Kept only when it stays bijective; returns whether it was kept.
+fn warp_to_anchors(
+    s: &mut SideDomain,
+    t: &SideDomain,
+    anchors: &[(VertexId, VertexId)],
+    untau: &dyn Fn(Uv) -> Uv,
+) -> Result<bool> {
+    let pairs = interior_copies(s, t, anchors);
+    if pairs.is_empty() {
+        return Ok(false);
+    }
+    let disk = &s.basis.disk.mesh;
+    let mut fixed_uv = s.domain.uv.clone();
+    let mut fixed: Vec<VertexId> = s.basis.walk.clone();
+    for &(a, b) in &pairs {
+        fixed_uv[a.idx()] = untau(t.domain.uv[b.idx()]);
+        fixed.push(a);
+    }
+    let mut sys = crate::linalg::FixedBoundarySystem::new(disk, &fixed)?;
+    sys.prepare_lu()?;
+    let w = crate::linalg::directed_weights(disk, crate::linalg::Weights::MeanValue);
+    let (uv, _) = sys.factor_weights(&w, false)?.solve_with_residual::<2>(&|v| fixed_uv[v.idx()])?;
+    let inj = super::domain::exact_orientation(disk, &uv);
+    if !inj.is_injective() {
+        return Ok(false);
+    }
+    s.domain.uv = uv;
+    s.domain.injectivity = inj;
+    Ok(true)
 }
 
 /// Every original vertex of `from` (through one of its disk copies) located in `to`'s domain.

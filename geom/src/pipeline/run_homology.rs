@@ -22,6 +22,8 @@ pub struct HomologyReport {
     pub rotation: usize,
     /// Polygon sides τ shifts by.
     pub side_shift: usize,
+    /// Whether the source domain was warped onto the anchors (constrained mean-value map).
+    pub anchor_warp: bool,
     /// Induced map on H1 (`a1, b1, …`), column `j` the image of source loop `j`.
     pub h1: Vec<Vec<i32>>,
     /// Base vertices (the first anchor pair).
@@ -77,7 +79,7 @@ pub fn run_homology(
         // composed map's folds on every pair measured (eight/cup, kitten/rocker arm): off.
         stretch_iterations: 0,
     };
-    let r = homology_map(source, target, pairs[0], &hopts)?;
+    let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
     clock.lap("basis_domain_map");
     progress.check()?;
     // Anchors beyond the base pair are placed exactly; smoothing then relaxes around them.
@@ -115,6 +117,7 @@ pub fn run_homology(
         basis: o.basis,
         rotation: o.rotation,
         side_shift: r.side_shift,
+        anchor_warp: r.warped,
         h1: r.h1.clone(),
         base: [pairs[0].0.0, pairs[0].1.0],
         subdivisions: [r.source.basis.subdivisions, r.target.basis.subdivisions],

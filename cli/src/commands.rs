@@ -149,7 +149,11 @@ pub fn map(
     let spec = match (spec, anchors) {
         (Some(s), _) => JobSpec::from_json(&read_bytes(s)?)?,
         (None, Some(a)) => {
-            let m = if method == "greedy" { Method::Greedy } else { Method::Voronoi };
+            let m = match method.as_str() {
+                "greedy" => Method::Greedy,
+                "homology" => Method::Homology,
+                _ => Method::Voronoi,
+            };
             JobSpec::from_anchors_json(&read_bytes(a)?, m)?
         }
         (None, None) => return Err(geom::InputError::Spec("give --anchors or --spec".into()).into()),

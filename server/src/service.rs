@@ -43,7 +43,7 @@ pub struct JobService {
 }
 
 /// The methods a job may name, in the order the docs list them.
-pub const METHODS: [&str; 2] = ["voronoi", "greedy"];
+pub const METHODS: [&str; 3] = ["voronoi", "greedy", "homology"];
 
 fn parse_format(hint: Option<&str>) -> Result<Option<Format>, ApiError> {
     Ok(match hint.map(str::to_ascii_lowercase).as_deref() {

@@ -186,3 +186,41 @@ async fn openapi_and_probes() {
     let (st, r) = json_call(&t, "GET", "/readyz", Body::empty()).await;
     assert_eq!((st, r["store"].as_str()), (StatusCode::OK, Some("sqlite")));
 }
+
+#[tokio::test]
+async fn homology_job_through_the_queue() {
+    let t = setup().await;
+    let s = geom::mesh::shapes::torus(32, 16, 1.0, 0.35);
+    let tg = s.with_positions(s.positions().iter().map(|p| geom::mesh::P3::new(p.x * 1.3, p.y, p.z * 0.9)).collect());
+    let (_, a) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&s, Format::Off))).await;
+    let (_, b) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&tg.unwrap(), Format::Off))).await;
+    assert_eq!(a["summary"]["genus"].as_i64(), Some(1), "{a}");
+    let spec = json!({"method": "homology", "anchors": [[0, 0]], "options": {"rotation": 0, "meta_mesh": true}});
+    let body = json!({"source": a["id"], "target": b["id"], "spec": spec}).to_string();
+    let req = Request::post("/v1/jobs").header("content-type", "application/json").body(Body::from(body)).unwrap();
+    let (st, _, job) = call(&t, req).await;
+    assert_eq!(st, StatusCode::ACCEPTED);
+    let id = serde_json::from_slice::<Value>(&job).unwrap()["id"].as_str().unwrap().to_string();
+    let (_tx, rx) = tokio::sync::watch::channel(false);
+    assert_eq!(t.worker.run_once(&rx).await.unwrap(), Ran::Ran { job: id.clone(), outcome: "succeeded".into() });
+    let (_, done) = json_call(&t, "GET", &format!("/v1/jobs/{id}"), Body::empty()).await;
+    assert_eq!(done["result"]["source_to_target"]["flipped_faces"], 0, "{done}");
+    assert_eq!(done["result"]["homology"]["h1"], json!([[1, 0], [0, 1]]), "{done}");
+    let (_, list) = json_call(&t, "GET", &format!("/v1/jobs/{id}/artifacts"), Body::empty()).await;
+    let names: Vec<&str> = list["artifacts"].as_array().unwrap().iter().filter_map(|a| a["name"].as_str()).collect();
+    for n in ["basis_source.json", "domain_target.obj", "meta_source.obj", "meta_target.obj", "metrics.json"] {
+        assert!(names.contains(&n), "{n} missing from {names:?}");
+    }
+    // Genus 0 has no homology basis: refused before queueing.
+    let (sp, _) = sphere_pair();
+    let (_, c) = json_call(&t, "POST", "/v1/meshes", Body::from(sp)).await;
+    let body = json!({"source": c["id"], "target": c["id"], "spec": {"method": "homology", "anchors": [[0, 0]]}});
+    let req = Request::post("/v1/jobs")
+        .header("content-type", "application/json")
+        .body(Body::from(body.to_string()))
+        .unwrap();
+    let (st, _, e) = call(&t, req).await;
+    assert!(st.is_client_error(), "{st}");
+    let e: Value = serde_json::from_slice(&e).unwrap();
+    assert_eq!(e["code"], "topology_mismatch", "{e}");
+}

@@ -149,7 +149,7 @@ pub fn map(
     let spec = match (spec, anchors) {
         (Some(s), _) => JobSpec::from_json(&read_bytes(s)?)?,
         (None, Some(a)) => {
-            let m = match method.as_str() {
+            let m = match method {
                 "greedy" => Method::Greedy,
                 "homology" => Method::Homology,
                 _ => Method::Voronoi,

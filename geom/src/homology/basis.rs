@@ -109,7 +109,7 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
         // that pen the corner in (neighbouring loop vertices joined by an edge) get those
         // edges split, which opens an interior vertex between them.
         let mut local = refined.clone();
-        for extra in 0..5 {
+        for extra in 0..6 {
             let t0 = std::time::Instant::now();
             let res = search(&local.mesh, base, g, opts.basis_index)?;
             debug(&format!(
@@ -126,11 +126,15 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
                 let valence = local.mesh.outgoing(base).count();
                 local = local.raise_valence(base, 2 * valence)?;
             } else {
-                let chords = chords_of(&local.mesh, &partial);
-                if chords.is_empty() {
+                // Loops that pen a corner in leave no vertex between them: split the chords
+                // joining them, then every edge at their vertices (a band of new vertices along
+                // each loop), and search again.
+                let split =
+                    if extra == 2 { chords_of(&local.mesh, &partial) } else { band_of(&local.mesh, &partial, base) };
+                if split.is_empty() {
                     break;
                 }
-                local = local.split_edges(&chords)?;
+                local = local.split_edges(&split)?;
             }
         }
         if round < opts.max_subdivisions {
@@ -196,6 +200,21 @@ fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<std::re
 
 type Loops = Vec<Vec<VertexId>>;
 
+/// Edges at the loops' vertices (the base vertex's own edges excepted).
+fn band_of(mesh: &Mesh, loops: &[Vec<VertexId>], base: VertexId) -> Vec<[VertexId; 2]> {
+    let mut on = vec![false; mesh.n_vertices()];
+    for l in loops {
+        for v in l {
+            on[v.idx()] = true;
+        }
+    }
+    on[base.idx()] = false;
+    (0..mesh.n_edges())
+        .map(|e| mesh.edge_vertices(crate::mesh::EdgeId::from_idx(e)))
+        .filter(|[a, b]| (on[a.idx()] || on[b.idx()]) && *a != base && *b != base)
+        .collect()
+}
+
 /// Edges that are not on the loops but join two of their vertices.
 fn chords_of(mesh: &Mesh, loops: &[Vec<VertexId>]) -> Vec<[VertexId; 2]> {
     let mut on = vec![false; mesh.n_vertices()];
@@ -237,7 +256,9 @@ fn cross(
         }
     };
     let to: Vec<VertexId> = local.iter().copied().filter(|&c| c != from).collect();
-    let Some(b) = interior_path(&s1.mesh, from, &to) else { return Ok(None) };
+    let on_a: std::collections::HashSet<VertexId> = a.iter().copied().collect();
+    let on_new = |w: VertexId| s1_local(&s1, s, w).is_some_and(|x| on_a.contains(&x));
+    let Some(b) = interior_path(&s1.mesh, from, &to, &on_new) else { return Ok(None) };
     let s2 = compose(&s1, cut_along(&s1.mesh, &path_edges(&s1.mesh, std::slice::from_ref(&b))?)?);
     Ok(Some((a.to_vec(), b, s1.orig, s2)))
 }

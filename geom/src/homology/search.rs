@@ -507,13 +507,39 @@ fn two_branch_dijkstra(
 }
 
 /// The shortest path from `from` to any of `to` through interior vertices only.
-pub fn interior_path(mesh: &Mesh, from: VertexId, to: &[VertexId]) -> Option<Vec<VertexId>> {
+///
+/// `on_new(w)` tells the boundary vertices of the loop just cut: a target corner's fan runs from
+/// that loop to older boundary, and arriving near the older boundary would leave a thin wedge
+/// there, which later becomes the corner of the next handle; those steps cost more.
+pub fn interior_path(
+    mesh: &Mesh,
+    from: VertexId,
+    to: &[VertexId],
+    on_new: &dyn Fn(VertexId) -> bool,
+) -> Option<Vec<VertexId>> {
     let is_target = |v: VertexId| to.contains(&v);
     let allowed = |v: VertexId| is_target(v) || !mesh.is_boundary_vertex(v);
     let mut ends = to.to_vec();
     ends.push(from);
     let near = near_boundary(mesh, &ends);
-    let weight = |w: VertexId| if near[w.idx()] { CLEARANCE } else { 1.0 };
+    let mut fan_cost = vec![1.0; mesh.n_vertices()];
+    for &c in to {
+        let fan: Vec<VertexId> = mesh.vertex_neighbors(c).collect();
+        let d = fan.len();
+        if d < 3 {
+            continue;
+        }
+        // Which end of the fan is the new loop; the other end is older boundary.
+        let (first_new, last_new) = (on_new(fan[0]), on_new(fan[d - 1]));
+        if first_new == last_new {
+            continue;
+        }
+        for (i, w) in fan.iter().enumerate() {
+            let from_old = if first_new { d - 1 - i } else { i } as f64 / (d - 1) as f64;
+            fan_cost[w.idx()] = 1.0 + 4.0 * (1.0 - from_old) * (1.0 - from_old);
+        }
+    }
+    let weight = |w: VertexId| if near[w.idx()] { CLEARANCE * fan_cost[w.idx()] } else { 1.0 };
     let (tree, hit) = dijkstra(mesh, &[from], &allowed, &|_| true, &is_target, &weight);
     let hit = hit?;
     let p = path_to(&tree, hit);

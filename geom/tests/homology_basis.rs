@@ -107,7 +107,6 @@ fn three_holes() {
 }
 
 #[test]
-#[ignore = "known gap: on this coarse genus-4 mesh (4.5k vertices) no crossing loop b is found for the second handle"]
 fn fertility() {
     check("fertility.off", 4);
 }

@@ -122,18 +122,18 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
                 Ok(loops) => return finish(local, base, loops, round),
                 Err(partial) => partial,
             };
-            if extra < 2 {
+            // Loops that pen a corner in leave no vertex between them: split every edge at
+            // their vertices (a band of new vertices along each loop); a crowded base vertex
+            // gets twice its edges; chords joining loop vertices are split. Then search again.
+            let split = match extra {
+                0 | 1 | 4 => band_of(&local.mesh, &partial, base),
+                3 => chords_of(&local.mesh, &partial),
+                _ => Vec::new(),
+            };
+            if extra == 2 {
                 let valence = local.mesh.outgoing(base).count();
                 local = local.raise_valence(base, 2 * valence)?;
-            } else {
-                // Loops that pen a corner in leave no vertex between them: split the chords
-                // joining them, then every edge at their vertices (a band of new vertices along
-                // each loop), and search again.
-                let split =
-                    if extra == 2 { chords_of(&local.mesh, &partial) } else { band_of(&local.mesh, &partial, base) };
-                if split.is_empty() {
-                    break;
-                }
+            } else if !split.is_empty() {
                 local = local.split_edges(&split)?;
             }
         }

@@ -190,9 +190,11 @@ fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<std::re
         if corners.is_empty() {
             return Err(Error::Internal(format!("basis: handle {} left a non-canonical word", handle + 1)));
         }
-        corners.sort_by_key(|&c| {
-            std::cmp::Reverse((reachable_interior(&s2.mesh, c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0)))
-        });
+        {
+            let reach = interior_components(&s2.mesh);
+            corners
+                .sort_by_key(|&c| std::cmp::Reverse((reach(c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0))));
+        }
         s = s2;
     }
     Ok(Ok(loops))
@@ -261,6 +263,46 @@ fn cross(
     let Some(b) = interior_path(&s1.mesh, from, &to, &on_new) else { return Ok(None) };
     let s2 = compose(&s1, cut_along(&s1.mesh, &path_edges(&s1.mesh, std::slice::from_ref(&b))?)?);
     Ok(Some((a.to_vec(), b, s1.orig, s2)))
+}
+
+/// For any vertex: how many interior vertices its interior neighbours reach through interior
+/// vertices (one labelling of the interior's components serves every corner).
+fn interior_components(mesh: &Mesh) -> impl Fn(VertexId) -> usize + '_ {
+    let n = mesh.n_vertices();
+    let mut comp = vec![u32::MAX; n];
+    let mut size: Vec<usize> = Vec::new();
+    for v0 in 0..n {
+        let v0 = VertexId::from_idx(v0);
+        if comp[v0.idx()] != u32::MAX || mesh.is_boundary_vertex(v0) {
+            continue;
+        }
+        let id = size.len() as u32;
+        let mut stack = vec![v0];
+        comp[v0.idx()] = id;
+        let mut count = 0;
+        while let Some(v) = stack.pop() {
+            count += 1;
+            for w in mesh.vertex_neighbors(v) {
+                if comp[w.idx()] == u32::MAX && !mesh.is_boundary_vertex(w) {
+                    comp[w.idx()] = id;
+                    stack.push(w);
+                }
+            }
+        }
+        size.push(count);
+    }
+    move |c: VertexId| {
+        let mut seen: Vec<u32> = Vec::new();
+        let mut total = 0;
+        for w in mesh.vertex_neighbors(c) {
+            let k = comp[w.idx()];
+            if k != u32::MAX && !seen.contains(&k) {
+                seen.push(k);
+                total += size[k as usize];
+            }
+        }
+        total
+    }
 }
 
 /// Interior vertices reachable from `corner` through interior vertices.

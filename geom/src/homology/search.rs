@@ -212,12 +212,12 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
         } else {
             CutMesh { mesh: mesh.clone(), orig: (0..n).map(VertexId::from_idx).collect() }
         };
-        let emask: Vec<u64> = (0..slit.mesh.n_edges())
-            .map(|k| {
-                let [a, b] = slit.mesh.edge_vertices(EdgeId::from_idx(k));
-                edge_between(mesh, slit.orig[a.idx()], slit.orig[b.idx()]).map_or(0, |e| coh.mask[e.idx()])
-            })
-            .collect();
+        // Cutting keeps faces and corners, so half-edge h of the slit mesh is half-edge h here.
+        let mut emask = vec![0u64; slit.mesh.n_edges()];
+        for h in 0..slit.mesh.n_halfedges() {
+            let h = crate::mesh::HalfedgeId::from_idx(h);
+            emask[slit.mesh.edge(h).idx()] = coh.mask[mesh.edge(h).idx()];
+        }
         let corners: Vec<VertexId> =
             (0..slit.mesh.n_vertices()).map(VertexId::from_idx).filter(|v| slit.orig[v.idx()] == corner).collect();
         let room = |lp: &[VertexId]| room_at_corner(mesh, corner, lp);

@@ -2,7 +2,9 @@
 """Method `homology` on same-shape cases (known correspondence) and different shapes: every
 rotation τ of the 4g-gon, judged by ../shared/eval/meshmetrics.py.
 
-usage: python3 bench/homology.py [path/to/surfmap] [filter]
+usage: [ANCHORS=k] [BASES=n] python3 bench/homology.py [path/to/surfmap] [filter]
+(ANCHORS: farthest-point anchors, the first is the base vertex; BASES: enumerate basis indices
+0..n on each mesh as well as every rotation.)
 """
 import json
 import os
@@ -58,18 +60,19 @@ def main():
         ("3holes bent (g3)", "3holes.off", "bend", 3),
     ]
     with tempfile.TemporaryDirectory() as tmp:
-        print("| case | rotation | time s | flips s→t/t→s | area | L2 | E_ang | anchor | gt mean | H1 |")
+        print("| case | basis s,t / rotation | time s | flips s→t/t→s | area | L2 | E_ang | anchor | gt mean | H1 |")
         print("|---|---|---|---|---|---|---|---|---|---|")
         for name, path, kind, g in cases:
             if filt not in name:
                 continue
             s, t, anchors, gt = table2.same_shape(tmp, name.split()[0], os.path.join(M, path), kind, int(os.environ.get("ANCHORS", "1")))
-            for rot in range(4 if g == 1 else g):
-                e = run(binary, tmp, s, t, anchors, gt, rot)
+            nb = int(os.environ.get("BASES", "1"))
+            for bs, bt, rot in [(i, j, r) for i in range(nb) for j in range(nb) for r in range(4 if g == 1 else g)]:
+                e = run(binary, tmp, s, t, anchors, gt, rot, (bs, bt))
                 if "error" in e:
-                    print(f"| {name} | {rot} | — | {e['error']} |")
+                    print(f"| {name} | {bs},{bt} / {rot} | — | {e['error']} |")
                     continue
-                print(f"| {name} | {rot} | {e['time']:.2f} | {e['flipped_faces']}/{e['rev_flips']} | "
+                print(f"| {name} | {bs},{bt} / {rot} | {e['time']:.2f} | {e['flipped_faces']}/{e['rev_flips']} | "
                       f"{e['area_ratio']:.4f} | {e['l2_stretch']:.4f} | {e['angle_distortion']:.3f} | "
                       f"{e['anchor_error_max']:.1e} | {e.get('gt_error_mean', float('nan')):.4f} | {e['h1']} |")
                 sys.stdout.flush()

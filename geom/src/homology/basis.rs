@@ -34,11 +34,14 @@ pub struct CanonicalBasisOptions {
     pub basis_index: usize,
     /// Rounds of midpoint subdivision allowed when loops would touch.
     pub max_subdivisions: usize,
+    /// Refinement steps to take before a basis is accepted (see
+    /// [`CanonicalBasisResult::attempt`]): two meshes mapped to each other are refined alike.
+    pub min_attempt: usize,
 }
 
 impl Default for CanonicalBasisOptions {
     fn default() -> Self {
-        Self { basis_index: 0, max_subdivisions: 2 }
+        Self { basis_index: 0, max_subdivisions: 2, min_attempt: 0 }
     }
 }
 
@@ -62,6 +65,8 @@ pub struct CanonicalBasisResult {
     pub word: Vec<Letter>,
     /// Subdivision rounds that were needed.
     pub subdivisions: usize,
+    /// Searches run before this basis was found (each failed one refines the mesh).
+    pub attempt: usize,
 }
 
 impl CanonicalBasisResult {
@@ -109,7 +114,8 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
         // that pen the corner in (neighbouring loop vertices joined by an edge) get those
         // edges split, which opens an interior vertex between them.
         let mut local = refined.clone();
-        for extra in 0..6 {
+        for extra in 0..ATTEMPTS_PER_ROUND {
+            let attempt = round * ATTEMPTS_PER_ROUND + extra;
             let t0 = std::time::Instant::now();
             let res = search(&local.mesh, base, g, opts.basis_index)?;
             debug(&format!(
@@ -119,8 +125,8 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
                 if res.is_ok() { "found" } else { "stuck" }
             ));
             let partial = match res {
-                Ok(loops) => return finish(local, base, loops, round),
-                Err(partial) => partial,
+                Ok(loops) if attempt >= opts.min_attempt => return finish(local, base, loops, round, attempt),
+                Ok(loops) | Err(loops) => loops,
             };
             // Loops that pen a corner in leave no vertex between them: split every edge at
             // their vertices (a band of new vertices along each loop); a crowded base vertex
@@ -150,7 +156,9 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
     .into())
 }
 
-/// Handle by handle on the surface cut so far; `None` when loops would have to touch.
+/// Searches per subdivision round (each failed one refines before the next).
+const ATTEMPTS_PER_ROUND: usize = 6;
+
 /// Handle by handle on the surface cut so far; `None` when loops would have to touch.
 /// Each handle tries the corners between commutators (most reachable interior first) and, at
 /// each, the shortest few non-separating classes, until one admits its crossing loop.
@@ -362,6 +370,7 @@ fn finish(
     base: VertexId,
     loops: Vec<Vec<VertexId>>,
     subdivisions: usize,
+    attempt: usize,
 ) -> Result<CanonicalBasisResult> {
     let on_cut = {
         let mut f = vec![false; refined.mesh.n_vertices()];
@@ -410,7 +419,18 @@ fn finish(
     let word: Vec<Letter> = (0..n).map(|i| w2.letters[(r2 + i) % n]).collect();
     let corners: Vec<usize> = (0..m).filter(|&i| disk.orig[walk[i].idx()] == base).collect();
     let intersection = intersection_matrix(&refined.mesh, base, &labeled);
-    Ok(CanonicalBasisResult { refined, base, loops: labeled, intersection, disk, walk, corners, word, subdivisions })
+    Ok(CanonicalBasisResult {
+        refined,
+        base,
+        loops: labeled,
+        intersection,
+        disk,
+        walk,
+        corners,
+        word,
+        subdivisions,
+        attempt,
+    })
 }
 
 fn debug(msg: &str) {

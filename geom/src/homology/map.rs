@@ -65,8 +65,9 @@ pub fn side_domain(
     index: usize,
     max_subdivisions: Option<usize>,
     stretch_iterations: usize,
+    min_attempt: usize,
 ) -> Result<SideDomain> {
-    let mut o = CanonicalBasisOptions { basis_index: index, ..Default::default() };
+    let mut o = CanonicalBasisOptions { basis_index: index, min_attempt, ..Default::default() };
     if let Some(m) = max_subdivisions {
         o.max_subdivisions = m;
     }
@@ -86,14 +87,28 @@ pub fn homology_map(
     anchors: &[(VertexId, VertexId)],
     opts: &HomologyMapOptions,
 ) -> Result<HomologyMapResult> {
+    let side = |m: &Mesh, b: VertexId, k: usize, min: usize| {
+        side_domain(m, b, opts.basis[k], opts.max_subdivisions, opts.stretch_iterations, min)
+    };
     let (s, t) = std::thread::scope(|sc| {
-        let h =
-            sc.spawn(|| side_domain(target, bases.1, opts.basis[1], opts.max_subdivisions, opts.stretch_iterations));
-        let s = side_domain(source, bases.0, opts.basis[0], opts.max_subdivisions, opts.stretch_iterations);
+        let h = sc.spawn(|| side(target, bases.1, 1, 0));
+        let s = side(source, bases.0, 0, 0);
         (s, h.join())
     });
-    let s = s?;
-    let t = t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??;
+    let (mut s, mut t) = (s?, t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??);
+    // Both meshes refined alike: the one found earlier is searched again up to the other's
+    // attempt, so that the same shape is cut by the same loops.
+    for _ in 0..3 {
+        let (a, b) = (s.basis.attempt, t.basis.attempt);
+        if a == b {
+            break;
+        }
+        if a < b {
+            s = side(source, bases.0, 0, b)?;
+        } else {
+            t = side(target, bases.1, 1, a)?;
+        }
+    }
     map_between(source, target, s, t, opts.rotation, anchors)
 }
 

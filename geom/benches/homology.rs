@@ -6,34 +6,15 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use geom::homology::{CanonicalBasisOptions, canonical_basis};
 use geom::io::{ReadOptions, read_path};
-use geom::mesh::{Mesh, P3, VertexId};
+use geom::mesh::{Mesh, VertexId};
 use geom::pipeline::{JobSpec, MapOptions, Method, run_map};
 use geom::progress::NoProgress;
-use std::path::PathBuf;
+
+mod common;
+use common::{bent, shared};
 
 fn load(name: &str) -> Mesh {
-    let p = std::env::var_os("SURFMAP_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared"))
-        .join("meshes")
-        .join(name);
-    read_path(&p, &ReadOptions::default()).expect("shared mesh").mesh
-}
-
-/// Bent along y (the kitten's long axis is irrelevant for timing).
-fn bent(m: &Mesh) -> Mesh {
-    let (lo, hi) = m.bbox();
-    let r = (hi.y - lo.y) * 1.2;
-    let cy = (lo.y + hi.y) / 2.0;
-    let pos = m
-        .positions()
-        .iter()
-        .map(|p| {
-            let u = (p.y - cy) / r;
-            P3::new(p.x, cy + r * u.sin(), p.z + r * (1.0 - u.cos()))
-        })
-        .collect();
-    m.with_positions(pos).expect("same faces")
+    read_path(&shared(name), &ReadOptions::default()).expect("shared mesh").mesh
 }
 
 fn bench(c: &mut Criterion) {

@@ -64,6 +64,17 @@ struct PV {
     next: Support,
 }
 
+/// `[x min, x max, y min, y max]` of a triangle.
+fn bbox(t: [Uv; 3]) -> [f64; 4] {
+    let (xs, ys) = (t.map(|p| p[0]), t.map(|p| p[1]));
+    [
+        xs.into_iter().fold(f64::MAX, f64::min),
+        xs.into_iter().fold(f64::MIN, f64::max),
+        ys.into_iter().fold(f64::MAX, f64::min),
+        ys.into_iter().fold(f64::MIN, f64::max),
+    ]
+}
+
 fn cross(a: Uv, b: Uv, c: Uv) -> f64 {
     (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
 }
@@ -87,11 +98,7 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
     let cell_of = |x: f64, k: usize| (((x - lo[k]) / cw).floor().max(0.0) as usize).min(cells - 1);
     let mut grid: Vec<Vec<u32>> = vec![Vec::new(); cells * cells];
     for (f, tri) in tt.iter().enumerate() {
-        let ps = tri.map(|v| ut[v as usize]);
-        let (x0, x1) =
-            (ps.iter().map(|p| p[0]).fold(f64::MAX, f64::min), ps.iter().map(|p| p[0]).fold(f64::MIN, f64::max));
-        let (y0, y1) =
-            (ps.iter().map(|p| p[1]).fold(f64::MAX, f64::min), ps.iter().map(|p| p[1]).fold(f64::MIN, f64::max));
+        let [x0, x1, y0, y1] = bbox(tri.map(|v| ut[v as usize]));
         for y in cell_of(y0, 1)..=cell_of(y1, 1) {
             for x in cell_of(x0, 0)..=cell_of(x1, 0) {
                 grid[y * cells + x].push(f as u32);
@@ -124,10 +131,7 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
     };
     for (sf, stri) in st.iter().enumerate() {
         let sp = stri.map(|v| us[v as usize]);
-        let (x0, x1) =
-            (sp.iter().map(|p| p[0]).fold(f64::MAX, f64::min), sp.iter().map(|p| p[0]).fold(f64::MIN, f64::max));
-        let (y0, y1) =
-            (sp.iter().map(|p| p[1]).fold(f64::MAX, f64::min), sp.iter().map(|p| p[1]).fold(f64::MIN, f64::max));
+        let [x0, x1, y0, y1] = bbox(sp);
         for y in cell_of(y0, 1)..=cell_of(y1, 1) {
             for x in cell_of(x0, 0)..=cell_of(x1, 0) {
                 for &tf in &grid[y * cells + x] {

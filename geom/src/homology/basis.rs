@@ -438,3 +438,41 @@ fn debug(msg: &str) {
         eprintln!("homology basis: {msg}");
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+
+    #[test]
+    fn torus_basis_is_canonical_and_certified() {
+        let t = shapes::torus(24, 12, 1.0, 0.3);
+        for base in [0u32, 37, 150] {
+            let r = canonical_basis(&t, VertexId(base), &CanonicalBasisOptions::default()).unwrap();
+            assert_eq!(r.word_text(), "a1 b1 a1^-1 b1^-1");
+            assert_eq!(r.intersection, vec![vec![0, 1], vec![-1, 0]]);
+            assert_eq!(topology::euler_characteristic(&r.disk.mesh), 1);
+            assert_eq!(r.corners.len(), 4);
+            // Loops are closed at the base and share no other vertex.
+            let mut seen = std::collections::HashSet::new();
+            for l in &r.loops {
+                assert_eq!((l[0], l[l.len() - 1]), (VertexId(base), VertexId(base)));
+                assert!(l[1..l.len() - 1].iter().all(|v| seen.insert(*v)));
+            }
+        }
+    }
+
+    #[test]
+    fn bases_are_enumerated_and_bad_input_refused() {
+        let t = shapes::torus(24, 12, 1.0, 0.3);
+        let o = |k| CanonicalBasisOptions { basis_index: k, ..Default::default() };
+        let a = canonical_basis(&t, VertexId(0), &o(0)).unwrap();
+        let b = canonical_basis(&t, VertexId(0), &o(1)).unwrap();
+        assert_ne!(a.loops, b.loops, "the second basis starts from another class");
+        let sphere = shapes::icosphere(2);
+        assert!(canonical_basis(&sphere, VertexId(0), &o(0)).unwrap_err().is_input());
+        assert!(canonical_basis(&t, VertexId(1_000_000), &o(0)).unwrap_err().is_input());
+        let disk = shapes::grid(4);
+        assert!(canonical_basis(&disk, VertexId(0), &o(0)).unwrap_err().is_input());
+    }
+}

@@ -143,3 +143,42 @@ impl UnionFind {
         true
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{VertexId, shapes};
+
+    fn mask_of(m: &Mesh, c: &Cohomology, path: &[u32]) -> u64 {
+        path.windows(2)
+            .map(|w| crate::homology::cut::edge_between(m, VertexId(w[0]), VertexId(w[1])).unwrap())
+            .fold(0, |acc, e| acc ^ c.mask[e.idx()])
+    }
+
+    #[test]
+    fn torus_has_two_generators_and_separates_correctly() {
+        // torus(n, m): vertex i*m + j, i around the big circle, j around the tube.
+        let (n, m) = (12usize, 6usize);
+        let t = shapes::torus(n, m, 1.0, 0.3);
+        let c = z2_cohomology(&t, &[]).unwrap();
+        assert_eq!(c.rank, 2);
+        let tube: Vec<u32> = (0..=m).map(|j| (j % m) as u32).collect();
+        let ring: Vec<u32> = (0..=n).map(|i| ((i % n) * m) as u32).collect();
+        assert_ne!(mask_of(&t, &c, &tube), 0, "a meridian does not separate");
+        assert_ne!(mask_of(&t, &c, &ring), 0, "a longitude does not separate");
+        assert_ne!(mask_of(&t, &c, &tube), mask_of(&t, &c, &ring), "different classes");
+        // The boundary of one face separates (bounds that face).
+        let f = t.face(crate::mesh::FaceId(0)).map(|v| v.0);
+        assert_eq!(mask_of(&t, &c, &[f[0], f[1], f[2], f[0]]), 0);
+    }
+
+    #[test]
+    fn more_than_one_boundary_loop_is_refused() {
+        let t = shapes::torus(12, 6, 1.0, 0.3);
+        let tube: Vec<VertexId> = (0..=6).map(|j| VertexId((j % 6) as u32)).collect();
+        let cut = crate::homology::cut::cut_along(&t, &crate::homology::cut::path_edges(&t, &[tube]).unwrap()).unwrap();
+        // An annulus: two boundary loops (the capped version is refused: more than one loop).
+        assert_eq!(boundary_loops(&cut.mesh).len(), 2);
+        assert!(z2_cohomology(&cut.mesh, &[]).is_err());
+    }
+}

@@ -151,3 +151,28 @@ impl Refined {
         self.split_edges(&all)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+
+    #[test]
+    fn refinement_keeps_the_surface_and_maps_back_exactly() {
+        let t = shapes::torus(10, 5, 1.0, 0.3);
+        let r = Refined::identity(&t).raise_valence(VertexId(0), 20).unwrap().subdivide().unwrap();
+        assert!(r.mesh.outgoing(VertexId(0)).count() >= 20);
+        assert_eq!(crate::topology::euler_characteristic(&r.mesh), 0);
+        assert!((r.mesh.area() - t.area()).abs() < 1e-12 * t.area());
+        // Every refined face centroid, mapped back, is the same 3D point on the original face.
+        for f in 0..r.mesh.n_faces() {
+            let f = FaceId::from_idx(f);
+            let p = r.mesh.face_points(f);
+            let c = P3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
+            let (of, b) = r.to_original(f, [1.0 / 3.0; 3]);
+            let q = t.face_points(of);
+            let back = q[0].coords * b[0] + q[1].coords * b[1] + q[2].coords * b[2];
+            assert!((c.coords - back).norm() < 1e-12);
+        }
+    }
+}

@@ -116,3 +116,24 @@ pub fn intersection_matrix(mesh: &Mesh, base: VertexId, loops: &[Vec<VertexId>])
     }
     m
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn w(s: &[(usize, i8)]) -> Vec<Letter> {
+        s.iter().map(|&(loop_id, dir)| Letter { loop_id, dir }).collect()
+    }
+
+    #[test]
+    fn canonical_rotations_find_commutator_products() {
+        // b a^-1 b^-1 a: a commutator read from another corner.
+        let one = w(&[(1, 1), (0, -1), (1, -1), (0, 1)]);
+        assert_eq!(canonical_rotations(&one), vec![0, 1, 2, 3]);
+        // a b a^-1 b^-1 c d c^-1 d^-1 rotated by 4: still canonical; by 2: not.
+        let two = w(&[(2, 1), (3, 1), (2, -1), (3, -1), (0, 1), (1, 1), (0, -1), (1, -1)]);
+        assert_eq!(canonical_rotations(&two), vec![0, 4]);
+        // a b a b: not a commutator.
+        assert!(canonical_rotations(&w(&[(0, 1), (1, 1), (0, 1), (1, 1)])).is_empty());
+    }
+}

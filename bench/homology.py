@@ -6,42 +6,22 @@ usage: [ANCHORS=k] [BASES=n] python3 bench/homology.py [path/to/surfmap] [filter
 (ANCHORS: farthest-point anchors, the first is the base vertex; BASES: enumerate basis indices
 0..n on each mesh as well as every rotation.)
 """
-import json
 import os
-import statistics
-import subprocess
 import sys
 import tempfile
-import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import table2  # noqa: E402  (case builders)
 
-mm = table2.mm
-np = table2.np
 M = table2.M
 
 
 def run(binary, tmp, s, t, anchors, gt, rotation, basis=(0, 0)):
-    spec = os.path.join(tmp, "spec.json")
-    json.dump({"method": "homology", "anchors": anchors,
-               "options": {"rotation": rotation, "basis": list(basis)}}, open(spec, "w"))
-    out = os.path.join(tmp, "out")
-    times = []
-    for _ in range(1):
-        t0 = time.perf_counter()
-        p = subprocess.run([binary, "map", s, t, "--spec", spec, "--out", out], capture_output=True, text=True)
-        times.append(time.perf_counter() - t0)
-        if p.returncode != 0:
-            return {"error": p.stderr.strip().splitlines()[-1]}
-    S, T, MP = mm.load_mesh(s), mm.load_mesh(t), mm.load_mesh(os.path.join(out, "source_on_target.obj"))
-    g = T[0][np.loadtxt(gt, dtype=np.int64)] if gt else None
-    e = mm.evaluate_map(S, T, MP, anchors, g, samples=100000)
-    rep = json.load(open(os.path.join(out, "metrics.json")))
-    e["time"] = statistics.median(times)
-    e["h1"] = rep["homology"]["h1"]
-    e["rev_flips"] = rep["target_to_source"]["flipped_faces"]
+    spec = {"method": "homology", "anchors": anchors, "options": {"rotation": rotation, "basis": list(basis)}}
+    e = table2.run(binary, tmp, "", s, t, anchors, gt, "homology", spec=spec, repeats=1)
+    if "error" not in e:
+        e["h1"] = e["report"]["homology"]["h1"]
     return e
 
 

@@ -166,15 +166,22 @@ def cases(tmp, binary):
     return out
 
 
-def run(binary, tmp, name, s, t, anchors, gt, method):
-    af = os.path.join(tmp, "anchors.json")
-    json.dump({"anchors": anchors}, open(af, "w"))
+def run(binary, tmp, name, s, t, anchors, gt, method, spec=None, repeats=3):
+    """Runs `surfmap map` `repeats` times (wall median) and judges the result with the evaluator.
+    `spec`: a whole job spec (written to a file and passed with --spec) instead of --method."""
+    if spec is None:
+        af = os.path.join(tmp, "anchors.json")
+        json.dump({"anchors": anchors}, open(af, "w"))
+        how = ["--anchors", af, "--method", method]
+    else:
+        sf = os.path.join(tmp, "spec.json")
+        json.dump(spec, open(sf, "w"))
+        how = ["--spec", sf]
     out = os.path.join(tmp, "out")
     times = []
-    for _ in range(3):
+    for _ in range(repeats):
         t0 = time.perf_counter()
-        p = subprocess.run([binary, "map", s, t, "--anchors", af, "--method", method, "--out", out],
-                           capture_output=True, text=True)
+        p = subprocess.run([binary, "map", s, t, *how, "--out", out], capture_output=True, text=True)
         times.append(time.perf_counter() - t0)
         if p.returncode != 0:
             return {"error": p.stderr.strip().splitlines()[-1]}
@@ -186,6 +193,7 @@ def run(binary, tmp, name, s, t, anchors, gt, method):
     e["patches"] = rep["patches"]
     e["own_l2"] = rep["source_to_target"]["l2_stretch"]
     e["rev_flips"] = rep["target_to_source"]["flipped_faces"]
+    e["report"] = rep
     return e
 
 

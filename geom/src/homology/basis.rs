@@ -118,12 +118,14 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
             let attempt = round * ATTEMPTS_PER_ROUND + extra;
             let t0 = std::time::Instant::now();
             let res = search(&local.mesh, base, g, opts.basis_index)?;
-            debug(&format!(
-                "attempt round {round} extra {extra}: {} vertices, {:.2} s, {}",
-                local.mesh.n_vertices(),
-                t0.elapsed().as_secs_f64(),
-                if res.is_ok() { "found" } else { "stuck" }
-            ));
+            debug(|| {
+                format!(
+                    "attempt round {round} extra {extra}: {} vertices, {:.2} s, {}",
+                    local.mesh.n_vertices(),
+                    t0.elapsed().as_secs_f64(),
+                    if res.is_ok() { "found" } else { "stuck" }
+                )
+            });
             let partial = match res {
                 Ok(loops) if attempt >= opts.min_attempt => return finish(local, base, loops, round, attempt),
                 Ok(loops) | Err(loops) => loops,
@@ -178,18 +180,20 @@ fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<std::re
                     break 'corners;
                 }
             }
-            debug(&format!(
-                "handle {handle}: no loop pair at corner {} ({n_cands} loops, fan {}, interior {})",
-                corner.0,
-                s.mesh.outgoing(corner).count(),
-                reachable_interior(&s.mesh, corner)
-            ));
+            debug(|| {
+                format!(
+                    "handle {handle}: no loop pair at corner {} ({n_cands} loops, fan {}, interior {})",
+                    corner.0,
+                    s.mesh.outgoing(corner).count(),
+                    interior_components(&s.mesh)(corner)
+                )
+            });
         }
         let Some((a, b, s1_orig_b, s2)) = done else { return Ok(Err(loops)) };
         loops.push(a.iter().map(|&v| s.orig[v.idx()]).collect());
         loops.push(b.iter().map(|&v| s1_orig_b[v.idx()]).collect());
         let Some(w) = read_word(&s2.mesh, &s2.orig, base, &loops) else {
-            debug(&format!("handle {handle}: cut surface word unreadable"));
+            debug(|| format!("handle {handle}: cut surface word unreadable"));
             return Ok(Err(loops));
         };
         // Any corner between commutators will do: most reachable interior first (loops that
@@ -313,26 +317,6 @@ fn interior_components(mesh: &Mesh) -> impl Fn(VertexId) -> usize + '_ {
     }
 }
 
-/// Interior vertices reachable from `corner` through interior vertices.
-fn reachable_interior(mesh: &Mesh, corner: VertexId) -> usize {
-    let mut seen = vec![false; mesh.n_vertices()];
-    let mut stack: Vec<VertexId> = mesh.vertex_neighbors(corner).filter(|&w| !mesh.is_boundary_vertex(w)).collect();
-    for w in &stack {
-        seen[w.idx()] = true;
-    }
-    let mut count = 0;
-    while let Some(v) = stack.pop() {
-        count += 1;
-        for w in mesh.vertex_neighbors(v) {
-            if !seen[w.idx()] && !mesh.is_boundary_vertex(w) {
-                seen[w.idx()] = true;
-                stack.push(w);
-            }
-        }
-    }
-    count
-}
-
 /// `inner` cut from `outer.mesh`; returns it with `orig` pointing into the uncut mesh.
 fn compose(outer: &CutMesh, inner: CutMesh) -> CutMesh {
     let orig = inner.orig.iter().map(|&v| outer.orig[v.idx()]).collect();
@@ -433,9 +417,10 @@ fn finish(
     })
 }
 
-fn debug(msg: &str) {
+/// Prints what `msg` says under `SURFMAP_DEBUG` (built only then).
+fn debug(msg: impl FnOnce() -> String) {
     if std::env::var_os("SURFMAP_DEBUG").is_some() {
-        eprintln!("homology basis: {msg}");
+        eprintln!("homology basis: {}", msg());
     }
 }
 

@@ -8,6 +8,7 @@
 //! on the source (barycentric in the source triangle it lies in) and on the target.
 
 use super::map::SideDomain;
+use crate::crossparam::locate2d::barycentric;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, P3, VertexId};
 use crate::param::Uv;
@@ -115,12 +116,7 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
     let mut faces: Vec<[u32; 3]> = Vec::new();
     let mut crossings = 0;
     let mut stamp = vec![u32::MAX; tt.len()];
-    let bary = |tri: [Uv; 3], p: Uv| {
-        let d = cross(tri[0], tri[1], tri[2]);
-        let l1 = cross(tri[0], p, tri[2]) / d;
-        let l2 = cross(tri[0], tri[1], p) / d;
-        [1.0 - l1 - l2, l1, l2].map(|x| x.clamp(0.0, 1.0))
-    };
+    let bary = |tri: [Uv; 3], p: Uv| barycentric(tri, p).map(|x| x.clamp(0.0, 1.0));
     let point = |m: &Mesh, tri: [u32; 3], b: [f64; 3]| {
         let s: f64 = b.iter().sum::<f64>().max(f64::MIN_POSITIVE);
         let mut acc = P3::origin().coords;

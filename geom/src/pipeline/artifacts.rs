@@ -7,6 +7,7 @@ use crate::domain::refine::Refined;
 use crate::domain::tracer::Tracer;
 use crate::error::{Error, Result};
 use crate::io::{self, Format};
+use crate::map::SurfaceMap;
 use crate::mesh::Mesh;
 use serde_json::json;
 
@@ -75,22 +76,28 @@ pub fn map_artifacts(
     let layout = json!({ "anchors": anchors, "paths": paths, "patches": pj });
     let layout = serde_json::to_vec_pretty(&layout).map_err(|e| Error::Internal(e.to_string()))?;
     // The large encodings are independent: build them on the thread pool.
-    let ((obj_t, obj_s), ((csv_st, csv_ts), (ply_s, ply_t))) = rayon::join(
-        || rayon::join(|| io::write(on_target, Format::Obj), || io::write(on_source, Format::Obj)),
-        || {
-            rayon::join(
-                || rayon::join(|| result.source_to_target.to_csv(), || result.target_to_source.to_csv()),
-                || rayon::join(|| layout_ply(rs), || layout_ply(rt)),
-            )
-        },
+    let (mut arts, (ply_s, ply_t)) = rayon::join(
+        || maps_and_meshes(&result.source_to_target, &result.target_to_source, on_target, on_source),
+        || rayon::join(|| layout_ply(rs), || layout_ply(rt)),
     );
-    Ok(vec![
+    arts.extend([
+        Artifact { name: "layout.json".into(), content_type: "application/json", bytes: layout },
+        Artifact { name: "layout_source.ply".into(), content_type: "application/vnd.ply", bytes: ply_s },
+        Artifact { name: "layout_target.ply".into(), content_type: "application/vnd.ply", bytes: ply_t },
+    ]);
+    Ok(arts)
+}
+
+/// The artifacts every method writes: both re-embedded meshes and both maps as CSV.
+pub fn maps_and_meshes(s2t: &SurfaceMap, t2s: &SurfaceMap, on_target: &Mesh, on_source: &Mesh) -> Vec<Artifact> {
+    let ((obj_t, obj_s), (csv_st, csv_ts)) = rayon::join(
+        || rayon::join(|| io::write(on_target, Format::Obj), || io::write(on_source, Format::Obj)),
+        || rayon::join(|| s2t.to_csv(), || t2s.to_csv()),
+    );
+    vec![
         Artifact { name: "source_on_target.obj".into(), content_type: "model/obj", bytes: obj_t },
         Artifact { name: "target_on_source.obj".into(), content_type: "model/obj", bytes: obj_s },
         Artifact { name: "source_to_target.csv".into(), content_type: "text/csv", bytes: csv_st.into_bytes() },
         Artifact { name: "target_to_source.csv".into(), content_type: "text/csv", bytes: csv_ts.into_bytes() },
-        Artifact { name: "layout.json".into(), content_type: "application/json", bytes: layout },
-        Artifact { name: "layout_source.ply".into(), content_type: "application/vnd.ply", bytes: ply_s },
-        Artifact { name: "layout_target.ply".into(), content_type: "application/vnd.ply", bytes: ply_t },
-    ])
+    ]
 }

@@ -1,15 +1,16 @@
 //! `run_homology`: canonical bases -> fundamental domains -> maps through the 4g-gon -> anchor
 //! snapping -> smoothing -> metrics -> artifacts (bases and domains included).
 
+use super::artifacts;
 use super::run::{Artifact, Clock, MapReport, both, finish_direction};
 use super::spec::JobSpec;
 use crate::domain::LayoutStats;
 use crate::error::{Error, Result};
 use crate::homology::{HomologyMapOptions, homology_map, map::SideDomain};
 use crate::io::{self, Format};
-use crate::map::SurfaceMap;
-use crate::mesh::{FaceId, Mesh, P3, VertexId};
+use crate::mesh::{Mesh, P3, VertexId};
 use crate::progress::{NoProgress, Progress};
+use crate::topology::SurfacePoint;
 use serde::Serialize;
 use serde_json::json;
 use std::time::Instant;
@@ -47,15 +48,6 @@ pub struct MetaMeshStats {
     pub error: Option<String>,
 }
 
-/// A point exactly at vertex `v` of `mesh`.
-fn at_vertex(mesh: &Mesh, v: VertexId) -> (FaceId, [f64; 3]) {
-    let h = mesh.outgoing(v).next().map(|h| (h.face(), h.corner()));
-    let (f, c) = h.unwrap_or((FaceId(0), 0));
-    let mut b = [0.0; 3];
-    b[c] = 1.0;
-    (f, b)
-}
-
 /// Runs a `homology` job.
 ///
 /// # Errors
@@ -85,10 +77,10 @@ pub fn run_homology(
     // Anchors beyond the base pair are placed exactly; smoothing then relaxes around them.
     let (mut s2t, mut t2s) = (r.source_to_target.clone(), r.target_to_source.clone());
     for &(s, t) in &pairs {
-        let (f, b) = at_vertex(target, t);
+        let (f, b) = SurfacePoint::Vertex { vertex: t }.in_face(target);
         s2t.face[s.idx()] = f;
         s2t.bary[s.idx()] = b;
-        let (f, b) = at_vertex(source, s);
+        let (f, b) = SurfacePoint::Vertex { vertex: s }.in_face(source);
         t2s.face[t.idx()] = f;
         t2s.bary[t.idx()] = b;
     }
@@ -112,19 +104,7 @@ pub fn run_homology(
             .map(|l| l.windows(2).map(|w| (m.position(w[1]) - m.position(w[0])).norm()).sum())
             .collect()
     };
-    let report = HomologyReport {
-        genus: g,
-        basis: o.basis,
-        rotation: o.rotation,
-        side_shift: r.side_shift,
-        anchor_warp: r.warped,
-        h1: r.h1.clone(),
-        base: [pairs[0].0.0, pairs[0].1.0],
-        subdivisions: [r.source.basis.subdivisions, r.target.basis.subdivisions],
-        loop_lengths: [len(&r.source), len(&r.target)],
-        meta_mesh: None,
-    };
-    let mut arts = common_artifacts(&s2t, &t2s, &on_target, &on_source);
+    let mut arts = artifacts::maps_and_meshes(&s2t, &t2s, &on_target, &on_source);
     let mut meta = None;
     if o.meta_mesh {
         progress.report("meta_mesh", 0.0);
@@ -150,7 +130,18 @@ pub fn run_homology(
         meta = Some(stats);
         clock.lap("meta_mesh");
     }
-    let report = HomologyReport { meta_mesh: meta, ..report };
+    let report = HomologyReport {
+        genus: g,
+        basis: o.basis,
+        rotation: o.rotation,
+        side_shift: r.side_shift,
+        anchor_warp: r.warped,
+        h1: r.h1.clone(),
+        base: [pairs[0].0.0, pairs[0].1.0],
+        subdivisions: [r.source.basis.subdivisions, r.target.basis.subdivisions],
+        loop_lengths: [len(&r.source), len(&r.target)],
+        meta_mesh: meta,
+    };
     arts.push(json_artifact("basis_source.json", &basis_json(&r.source))?);
     arts.push(json_artifact("basis_target.json", &basis_json(&r.target))?);
     arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });
@@ -183,19 +174,6 @@ pub fn run_homology(
 fn json_artifact(name: &str, v: &serde_json::Value) -> Result<Artifact> {
     let bytes = serde_json::to_vec_pretty(v).map_err(|e| Error::Internal(e.to_string()))?;
     Ok(Artifact { name: name.into(), content_type: "application/json", bytes })
-}
-
-fn common_artifacts(s2t: &SurfaceMap, t2s: &SurfaceMap, on_target: &Mesh, on_source: &Mesh) -> Vec<Artifact> {
-    let ((obj_t, obj_s), (csv_st, csv_ts)) = rayon::join(
-        || rayon::join(|| io::write(on_target, Format::Obj), || io::write(on_source, Format::Obj)),
-        || rayon::join(|| s2t.to_csv(), || t2s.to_csv()),
-    );
-    vec![
-        Artifact { name: "source_on_target.obj".into(), content_type: "model/obj", bytes: obj_t },
-        Artifact { name: "target_on_source.obj".into(), content_type: "model/obj", bytes: obj_s },
-        Artifact { name: "source_to_target.csv".into(), content_type: "text/csv", bytes: csv_st.into_bytes() },
-        Artifact { name: "target_to_source.csv".into(), content_type: "text/csv", bytes: csv_ts.into_bytes() },
-    ]
 }
 
 /// Loops as 3D polylines (a1, b1, …), with vertex ids where they are original vertices, the

@@ -23,6 +23,7 @@ pub mod metrics;
 pub mod param;
 pub mod pipeline;
 pub mod progress;
+pub mod quad;
 pub mod simplify;
 pub mod tol;
 pub mod topology;

@@ -13,6 +13,9 @@ pub struct VertexDijkstraOptions<'a> {
     pub max_distance: Option<f64>,
     /// Stop as soon as this vertex is settled.
     pub target: Option<VertexId>,
+    /// Vertices that may not be entered (indexed by vertex), except `target`: paths kept
+    /// vertex-disjoint from earlier paths.
+    pub blocked: Option<&'a [bool]>,
 }
 
 /// Distances and shortest-path tree.
@@ -61,10 +64,30 @@ pub fn vertex_dijkstra(
             InputError::Invalid(format!("face mask has {} entries for {} faces", m.len(), mesh.n_faces())).into()
         );
     }
+    if let Some(b) = opts.blocked
+        && b.len() != nv
+    {
+        return Err(InputError::Invalid(format!("vertex mask has {} entries for {nv} vertices", b.len())).into());
+    }
     let mut dist = vec![f64::INFINITY; nv];
     let mut pred = vec![VertexId::INVALID; nv];
     let mut source = vec![u32::MAX; nv];
     let mut done = vec![false; nv];
+    if let Some(b) = opts.blocked {
+        for (d, &b) in done.iter_mut().zip(b) {
+            *d = b;
+        }
+        if let Some(t) = opts.target
+            && t.idx() < nv
+        {
+            done[t.idx()] = false;
+        }
+        for &(s, _) in sources {
+            if s.idx() < nv {
+                done[s.idx()] = false;
+            }
+        }
+    }
     let mut heap = MinHeap::with_capacity(1024);
     for (i, &(s, d0)) in sources.iter().enumerate() {
         if s.idx() >= nv {

@@ -3,7 +3,7 @@
 
 pub mod qem;
 
-pub use qem::{Collapse, DecimateOptions, DecimateResult, decimate};
+pub use qem::{Collapse, CollapseHistory, DecimateOptions, DecimateResult, decimate};
 
 #[cfg(test)]
 mod tests {

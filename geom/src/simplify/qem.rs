@@ -29,11 +29,21 @@ pub struct DecimateOptions {
     pub boundary_weight: f64,
     /// Smallest cosine between a face normal before and after a collapse.
     pub min_normal_cos: f64,
+    /// Refuse collapses that would create an interior edge between two boundary vertices (a
+    /// chord): with the boundary fixed on a convex polygon such an edge can lie along a side,
+    /// and its faces would be degenerate in the plane.
+    pub no_chords: bool,
 }
 
 impl Default for DecimateOptions {
     fn default() -> Self {
-        Self { target_vertices: 0, protected: Vec::new(), boundary_weight: 100.0, min_normal_cos: 0.2 }
+        Self {
+            target_vertices: 0,
+            protected: Vec::new(),
+            boundary_weight: 100.0,
+            min_normal_cos: 0.2,
+            no_chords: false,
+        }
     }
 }
 
@@ -53,6 +63,25 @@ pub struct DecimateResult {
     pub kept: Vec<VertexId>,
     /// The collapses in the order they were made (a progressive mesh read backwards).
     pub collapses: Vec<Collapse>,
+    /// Everything needed to undo the collapses one by one (vertex splits).
+    pub history: CollapseHistory,
+}
+
+/// The face soup of the decimation in input vertex ids, and per collapse the faces it deleted
+/// and the faces it rewrote (`from` replaced by `to`). Undoing collapses in reverse order
+/// (revive the deleted faces, put `from` back into the rewritten ones) replays the
+/// progressive mesh from the base mesh up to the input.
+#[derive(Debug, Clone, Default)]
+pub struct CollapseHistory {
+    /// Every input face, as it stands after the last collapse (dead faces as they were when
+    /// they died).
+    pub faces: Vec<[u32; 3]>,
+    /// Whether each face is in the base mesh.
+    pub alive: Vec<bool>,
+    /// Per collapse (same order as `collapses`): deleted face ids.
+    pub deleted: Vec<Vec<u32>>,
+    /// Per collapse: rewritten face ids.
+    pub rewritten: Vec<Vec<u32>>,
 }
 
 /// Symmetric 4x4 quadric, upper triangle row by row.
@@ -116,6 +145,7 @@ struct Work<'a> {
     q: Vec<Quadric>,
     stamp: Vec<u32>,
     min_cos: f64,
+    no_chords: bool,
 }
 
 impl Work<'_> {
@@ -156,6 +186,12 @@ impl Work<'_> {
             return false;
         }
         if self.boundary[u as usize] && !(on_edge.len() == 1 && self.is_boundary_edge(u, v)) {
+            return false;
+        }
+        if self.no_chords
+            && self.boundary[v as usize]
+            && nu.iter().any(|&w| w != v && self.boundary[w as usize] && !on_edge.contains(&w))
+        {
             return false;
         }
         // Link condition.
@@ -200,12 +236,15 @@ impl Work<'_> {
         best
     }
 
-    fn collapse(&mut self, u: u32, v: u32) {
+    /// Collapses `u` into `v`; returns the deleted and the rewritten faces.
+    fn collapse(&mut self, u: u32, v: u32) -> (Vec<u32>, Vec<u32>) {
         let fu = std::mem::take(&mut self.vf[u as usize]);
+        let (mut deleted, mut rewritten) = (Vec::with_capacity(2), Vec::with_capacity(fu.len()));
         for f in fu {
             let t = &mut self.faces[f as usize];
             if t.contains(&v) {
                 self.alive[f as usize] = false;
+                deleted.push(f);
                 for w in *t {
                     if w != u {
                         self.vf[w as usize].retain(|&g| g != f);
@@ -218,10 +257,12 @@ impl Work<'_> {
                     }
                 }
                 self.vf[v as usize].push(f);
+                rewritten.push(f);
             }
         }
         let qu = self.q[u as usize];
         self.q[v as usize].add(&qu);
+        (deleted, rewritten)
     }
 }
 
@@ -287,6 +328,7 @@ pub fn decimate(mesh: &Mesh, opts: &DecimateOptions) -> Result<DecimateResult> {
         q,
         stamp: vec![0; nv],
         min_cos: opts.min_normal_cos,
+        no_chords: opts.no_chords,
     };
     let (mut nu, mut nvb, mut ring) = (Vec::new(), Vec::new(), Vec::new());
     let mut heap = BinaryHeap::with_capacity(nv);
@@ -297,6 +339,7 @@ pub fn decimate(mesh: &Mesh, opts: &DecimateOptions) -> Result<DecimateResult> {
     }
     let mut remaining = nv;
     let mut collapses = Vec::new();
+    let (mut deleted, mut rewritten) = (Vec::new(), Vec::new());
     let mut removed = vec![false; nv];
     while remaining > opts.target_vertices.max(4) {
         let Some(c) = heap.pop() else { break };
@@ -313,7 +356,9 @@ pub fn decimate(mesh: &Mesh, opts: &DecimateOptions) -> Result<DecimateResult> {
             }
             continue;
         }
-        w.collapse(c.from, c.to);
+        let (del, rew) = w.collapse(c.from, c.to);
+        deleted.push(del);
+        rewritten.push(rew);
         removed[c.from as usize] = true;
         remaining -= 1;
         collapses.push(Collapse { from: VertexId::from_idx(c.from as usize), to: VertexId::from_idx(c.to as usize) });
@@ -337,5 +382,6 @@ pub fn decimate(mesh: &Mesh, opts: &DecimateOptions) -> Result<DecimateResult> {
         w.faces.iter().zip(&w.alive).filter(|(_, a)| **a).map(|(t, _)| t.map(|v| new_id[v as usize])).collect();
     let out = Mesh::from_triangles(kept.iter().map(|&v| pos[v.idx()]).collect(), &tris)
         .map_err(|e| Error::Internal(format!("decimation broke the mesh: {e}")))?;
-    Ok(DecimateResult { mesh: out, kept, collapses })
+    let history = CollapseHistory { faces: w.faces, alive: w.alive, deleted, rewritten };
+    Ok(DecimateResult { mesh: out, kept, collapses, history })
 }

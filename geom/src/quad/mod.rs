@@ -1,0 +1,22 @@
+//! Method `quad` (Yu & Chuang, "Consistent Mesh Parameterizations and Its Application in Mesh
+//! Morphing"): N models cut the same way into quad patches, every patch parameterized over the
+//! unit square with stretch optimization and feature alignment, then resampled on one
+//! semi-regular grid so all remeshes share their connectivity.
+//!
+//! - [`layout`]: the patch/corner/curve combinatorics shared by all models.
+//! - [`partition`]: the genus-0 two-quad partition from four partition points.
+//! - [`patch_param`]: progressive mesh, mean-value base embedding, coarse-to-fine refinement.
+//! - [`stretch`], [`brent`], [`kernel`]: Sander's vertex optimization and its helpers.
+//! - [`remesh`]: uniform resampling.
+
+pub mod brent;
+pub mod kernel;
+pub mod layout;
+pub mod partition;
+pub mod patch_param;
+pub mod remesh;
+pub mod stretch;
+
+pub use layout::{QuadLayout, QuadPatchLayout, QuadSide};
+pub use partition::{PartitionOptions, PartitionResult, PatchMesh, partition_genus0};
+pub use patch_param::{BaseEmbedding, PatchParamResult, QuadParamOptions, base_embedding, coarse_to_fine};

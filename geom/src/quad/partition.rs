@@ -1,0 +1,231 @@
+//! Consistent partition of a genus-0 mesh into two quad patches (Yu & Chuang, section 3.2):
+//! shortest edge paths p0 -> p1 -> p2 -> p3 -> p0 between the four partition points, each kept
+//! vertex-disjoint from the ones before (so the loop is simple and cannot cross itself), cut the
+//! closed surface into two disks. Edges between two loop vertices that are not loop edges
+//! (chords) are split first, so no patch triangle has all three corners on its boundary, which
+//! the unit square would flatten. Refinement only adds edge midpoints: the surface is unchanged.
+
+use super::layout::{QuadLayout, SQUARE};
+use crate::error::{Error, InputError, Result};
+use crate::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
+use crate::homology::cut::{cut_along, path_edges};
+use crate::homology::refine::Refined;
+use crate::mesh::{FaceId, Mesh, VertexId};
+use crate::param::{Uv, disk_boundary};
+use crate::topology::components;
+
+/// Options of [`partition_genus0`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PartitionOptions {
+    /// Global midpoint subdivisions allowed when the four paths cannot be kept disjoint.
+    pub max_subdivisions: usize,
+}
+
+impl Default for PartitionOptions {
+    fn default() -> Self {
+        Self { max_subdivisions: 2 }
+    }
+}
+
+/// One quad patch of one model, as its own disk mesh.
+#[derive(Debug, Clone)]
+pub struct PatchMesh {
+    pub mesh: Mesh,
+    /// Per local vertex: its vertex in the refined model.
+    pub parent: Vec<VertexId>,
+    /// Per local vertex: its fixed unit-square position if it is on the patch boundary (by arc
+    /// length along the layout curve, the same fractions on both patches that share it).
+    pub boundary_uv: Vec<Option<Uv>>,
+    /// Local ids of the four corners.
+    pub corners: [VertexId; 4],
+    /// (feature index, local vertex) of the feature points inside this patch.
+    pub features: Vec<(usize, VertexId)>,
+}
+
+/// A model cut into the patches of [`QuadLayout::genus0`].
+#[derive(Debug, Clone)]
+pub struct PartitionResult {
+    /// The model after chord splits and subdivisions (a geometric no-op).
+    pub refined: Refined,
+    /// The layout curves as vertex paths of the refined model.
+    pub curves: Vec<Vec<VertexId>>,
+    pub patches: Vec<PatchMesh>,
+    /// Global subdivisions that were needed.
+    pub subdivisions: usize,
+}
+
+/// Partitions a closed genus-0 mesh by four partition points; `features` stay off the loop.
+///
+/// # Errors
+/// `InputError::Anchors` for repeated points, `InputError::LayoutConflict` when disjoint paths
+/// cannot be found even after subdivision.
+pub fn partition_genus0(
+    mesh: &Mesh,
+    points: [VertexId; 4],
+    features: &[VertexId],
+    opts: &PartitionOptions,
+) -> Result<PartitionResult> {
+    for (i, p) in points.iter().enumerate() {
+        if p.idx() >= mesh.n_vertices() {
+            return Err(InputError::OutOfRange { what: "partition point", index: p.idx(), count: mesh.n_vertices() }.into());
+        }
+        if points[..i].contains(p) || features.contains(p) {
+            return Err(InputError::Anchors(format!("partition point {i} (vertex {}) is used twice", p.0)).into());
+        }
+    }
+    let mut refined = Refined::identity(mesh);
+    for round in 0..=opts.max_subdivisions {
+        if let Some(curves) = trace_loop(&refined.mesh, points, features)? {
+            return finish(refined, curves, points, features, round);
+        }
+        if round < opts.max_subdivisions {
+            refined = refined.subdivide()?;
+        }
+    }
+    Err(InputError::LayoutConflict(format!(
+        "the partition points cannot be joined by disjoint paths p0->p1->p2->p3->p0 (after {} subdivisions)",
+        opts.max_subdivisions
+    ))
+    .into())
+}
+
+/// The four paths, or `None` when one is walled off by the ones before.
+fn trace_loop(mesh: &Mesh, points: [VertexId; 4], features: &[VertexId]) -> Result<Option<Vec<Vec<VertexId>>>> {
+    let mut blocked = vec![false; mesh.n_vertices()];
+    for v in points.iter().chain(features) {
+        blocked[v.idx()] = true;
+    }
+    let mut curves = Vec::with_capacity(4);
+    for k in 0..4 {
+        let (a, b) = (points[k], points[(k + 1) % 4]);
+        let opts = VertexDijkstraOptions { target: Some(b), blocked: Some(&blocked), ..Default::default() };
+        let r = vertex_dijkstra(mesh, &[(a, 0.0)], &opts)?;
+        let Some(path) = r.path_to(b) else { return Ok(None) };
+        for v in &path {
+            blocked[v.idx()] = true;
+        }
+        curves.push(path);
+    }
+    Ok(Some(curves))
+}
+
+fn finish(
+    refined: Refined,
+    curves: Vec<Vec<VertexId>>,
+    points: [VertexId; 4],
+    features: &[VertexId],
+    subdivisions: usize,
+) -> Result<PartitionResult> {
+    // Split chords: interior edges with both ends on the loop.
+    let mut on_loop = vec![false; refined.mesh.n_vertices()];
+    for c in &curves {
+        for v in c {
+            on_loop[v.idx()] = true;
+        }
+    }
+    let loop_edges = path_edges(&refined.mesh, &curves)?;
+    let chords: Vec<[VertexId; 2]> = (0..refined.mesh.n_edges())
+        .filter(|&e| !loop_edges[e])
+        .map(|e| refined.mesh.edge_vertices(crate::EdgeId::from_idx(e)))
+        .filter(|[a, b]| on_loop[a.idx()] && on_loop[b.idx()])
+        .collect();
+    let refined = refined.split_edges(&chords)?;
+    let mesh = &refined.mesh;
+    let cut_flags = path_edges(mesh, &curves)?;
+    let cut = cut_along(mesh, &cut_flags)?;
+    let comps = components(&cut.mesh);
+    if comps.count != 2 {
+        return Err(Error::Internal(format!("the partition loop left {} pieces, not 2", comps.count)));
+    }
+    // Patch 0 lies left of p0 -> p1 (faces are counter-clockwise seen from outside).
+    let h = mesh
+        .find_halfedge(curves[0][0], curves[0][1])
+        .ok_or_else(|| Error::Internal("first loop edge has no half-edge".into()))?;
+    let first = comps.face_label[h.face().idx()];
+    // Arc-length fraction of every loop vertex along its curve (corners excepted).
+    let mut frac = vec![(u32::MAX, 0.0); mesh.n_vertices()];
+    for (c, path) in curves.iter().enumerate() {
+        let mut cum = vec![0.0; path.len()];
+        for i in 1..path.len() {
+            cum[i] = cum[i - 1] + (mesh.position(path[i]) - mesh.position(path[i - 1])).norm();
+        }
+        let total = cum[path.len() - 1].max(f64::MIN_POSITIVE);
+        for i in 1..path.len() - 1 {
+            frac[path[i].idx()] = (c as u32, cum[i] / total);
+        }
+    }
+    let layout = QuadLayout::genus0();
+    let mut patches = Vec::with_capacity(2);
+    for (pi, pl) in layout.patches.iter().enumerate() {
+        let label = if pi == 0 { first } else { 1 - first };
+        let corners = pl.corners.map(|c| points[c as usize]);
+        patches.push(extract_patch(mesh, &cut, &comps.face_label, label, corners, pl, &frac, features)?);
+    }
+    Ok(PartitionResult { refined, curves, patches, subdivisions })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn extract_patch(
+    mesh: &Mesh,
+    cut: &crate::homology::cut::CutMesh,
+    face_label: &[u32],
+    label: u32,
+    corners: [VertexId; 4],
+    pl: &super::layout::QuadPatchLayout,
+    frac: &[(u32, f64)],
+    features: &[VertexId],
+) -> Result<PatchMesh> {
+    let mut local = vec![u32::MAX; cut.mesh.n_vertices()];
+    let mut parent = Vec::new();
+    let mut tris = Vec::new();
+    for (f, &l) in face_label.iter().enumerate() {
+        if l != label {
+            continue;
+        }
+        let t = cut.mesh.face(FaceId::from_idx(f)).map(|v| {
+            if local[v.idx()] == u32::MAX {
+                local[v.idx()] = parent.len() as u32;
+                parent.push(cut.orig[v.idx()]);
+            }
+            local[v.idx()]
+        });
+        tris.push(t);
+    }
+    let pos = parent.iter().map(|&v| mesh.position(v)).collect();
+    let pmesh = Mesh::from_triangles(pos, &tris).map_err(|e| Error::Internal(format!("patch mesh invalid: {e}")))?;
+    let find = |v: VertexId| parent.iter().position(|&p| p == v).map(VertexId::from_idx);
+    let local_corners = corners.map(find);
+    let [Some(c0), Some(c1), Some(c2), Some(c3)] = local_corners else {
+        return Err(Error::Internal("a patch misses one of its corners".into()));
+    };
+    let lc = [c0, c1, c2, c3];
+    let mut lp = disk_boundary(&pmesh)?;
+    let start = lp.iter().position(|&v| v == c0).ok_or_else(|| Error::Internal("corner 0 off the boundary".into()))?;
+    lp.rotate_left(start);
+    let mut boundary_uv = vec![None; parent.len()];
+    let mut k = 0usize;
+    for &v in &lp {
+        if let Some(j) = lc.iter().position(|&c| c == v) {
+            if j != k && !(j == k + 1 && k < 3) {
+                return Err(Error::Internal(format!("patch corners out of order on its boundary ({k} then {j})")));
+            }
+            k = j;
+            boundary_uv[v.idx()] = Some(SQUARE[j]);
+            continue;
+        }
+        let (c, t) = frac[parent[v.idx()].idx()];
+        let side = pl.sides[k];
+        if c != side.curve {
+            return Err(Error::Internal(format!("boundary vertex on curve {c}, expected curve {}", side.curve)));
+        }
+        let s = if side.reversed { 1.0 - t } else { t };
+        let (a, b) = (SQUARE[k], SQUARE[(k + 1) % 4]);
+        boundary_uv[v.idx()] = Some([a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])]);
+    }
+    if k != 3 {
+        return Err(Error::Internal(format!("patch boundary passes {} corners, not 4", k + 1)));
+    }
+    let features =
+        features.iter().enumerate().filter_map(|(i, &f)| find(f).map(|l| (i, l))).collect::<Vec<(usize, VertexId)>>();
+    Ok(PatchMesh { mesh: pmesh, parent, boundary_uv, corners: lc, features })
+}

@@ -172,3 +172,22 @@ pub fn map(
     }
     serde_json::to_string_pretty(&report).map_err(|e| geom::Error::Internal(e.to_string()))
 }
+
+pub fn remesh(meshes: &[std::path::PathBuf], spec: &Path, out: &Path) -> Result<String> {
+    use std::io::IsTerminal;
+    let bytes =
+        std::fs::read(spec).map_err(|e| geom::InputError::Invalid(format!("cannot read {}: {e}", spec.display())))?;
+    let spec = geom::pipeline::RemeshSpec::from_json(&bytes)?;
+    let models = meshes.iter().map(|m| read(m).map(|r| r.mesh)).collect::<Result<Vec<_>>>()?;
+    let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
+    let (report, artifacts) = geom::pipeline::run_remesh(&spec, &models, &mut progress)?;
+    if progress.tty {
+        eprintln!();
+    }
+    std::fs::create_dir_all(out)
+        .map_err(|e| geom::InputError::Invalid(format!("cannot create {}: {e}", out.display())))?;
+    for a in &artifacts {
+        io::write_bytes(&out.join(&a.name), &a.bytes)?;
+    }
+    serde_json::to_string_pretty(&report).map_err(|e| geom::Error::Internal(e.to_string()))
+}

@@ -73,6 +73,21 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Consistent quad parameterization of two or more genus-0 meshes and semi-regular remeshes
+    /// with identical connectivity (method `quad`). Writes remesh_<i>.obj, param_<i>.obj,
+    /// geometry images and normal maps, morph.glb and metrics.json.
+    Remesh {
+        /// The meshes, in the order of the anchor columns.
+        #[arg(required = true, num_args = 1..)]
+        meshes: Vec<PathBuf>,
+        /// The job spec `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}`;
+        /// the first four anchor rows are the partition points.
+        #[arg(long)]
+        spec: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -94,6 +109,7 @@ fn main() -> ExitCode {
         Command::Map { source, target, anchors, spec, method, out } => {
             commands::map(&source, &target, anchors.as_deref(), spec.as_deref(), &method, &out)
         }
+        Command::Remesh { meshes, spec, out } => commands::remesh(&meshes, &spec, &out),
     };
     match result {
         Ok(out) => {

@@ -30,7 +30,7 @@ fn main() {
         let t = std::time::Instant::now();
         let b = base_embedding(p, &opts).unwrap();
         let tb = t.elapsed().as_secs_f64();
-        let r = coarse_to_fine(p, b, &[], &opts).unwrap();
+        let r = coarse_to_fine(p, b, &[], &opts, &mut geom::progress::NoProgress).unwrap();
         println!(
             "patch V={} base {} mv {:?} opt {:?} | full mv {:?} final {:?} flips {} base {:.3}s total {:.3}s",
             p.mesh.n_vertices(),

@@ -1,14 +1,19 @@
 //! Mesh files: format detection from content, readers (OBJ, OFF, PLY, STL) and writers.
 //! This is the only module of the crate that touches bytes or files.
 
+mod gltf;
 mod lex;
 mod obj;
 mod off;
+mod png16;
 mod ply;
 mod ply_binary;
 mod stl;
 
+pub use gltf::write_glb;
+pub use obj::write_uv_patches as write_obj_uv_patches;
 pub use ply::write_with_face_ints as write_ply_with_face_ints;
+pub use png16::{read_rgb16, write_rgb16};
 
 use crate::error::{InputError, Result};
 use crate::mesh::{Mesh, MeshLimits, RawMesh, Warning};

@@ -253,3 +253,23 @@ pub(crate) fn write(mesh: &Mesh, out: &mut Vec<u8>) {
         };
     }
 }
+
+/// Writes patches as one OBJ: every patch's vertices with their parameter coordinates as `vt`,
+/// and its faces under `g patch_<p>` as `f a/a b/b c/c`.
+pub fn write_uv_patches(patches: &[(&Mesh, &[[f64; 2]])]) -> Vec<u8> {
+    use std::io::Write;
+    let mut out = Vec::new();
+    let mut base = 1usize;
+    for (p, (mesh, uv)) in patches.iter().enumerate() {
+        for (x, t) in mesh.positions().iter().zip(uv.iter()) {
+            let _ = writeln!(out, "v {} {} {}\nvt {} {}", x.x, x.y, x.z, t[0], t[1]);
+        }
+        let _ = writeln!(out, "g patch_{p}");
+        for f in mesh.faces() {
+            let [a, b, c] = f.map(|v| v.idx() + base);
+            let _ = writeln!(out, "f {a}/{a} {b}/{b} {c}/{c}");
+        }
+        base += mesh.n_vertices();
+    }
+    out
+}

@@ -5,7 +5,11 @@
 mod artifacts;
 mod run;
 mod run_homology;
+mod remesh_spec;
+mod run_quad;
 mod spec;
 
 pub use run::{Artifact, MapReport, run_map};
+pub use remesh_spec::{Interpolation, LevelSchedule, MAX_MODELS, MorphDomain, MorphOptions, QuadMethod, QuadOptions, RemeshSpec};
+pub use run_quad::{RemeshReport, run_remesh};
 pub use spec::{JobSpec, MAX_ANCHORS, MapOptions, Method};

@@ -7,15 +7,21 @@
 //! - [`partition`]: the genus-0 two-quad partition from four partition points.
 //! - [`patch_param`]: progressive mesh, mean-value base embedding, coarse-to-fine refinement.
 //! - [`stretch`], [`brent`], [`kernel`]: Sander's vertex optimization and its helpers.
-//! - [`remesh`]: uniform resampling.
+//! - [`remesh`]: uniform resampling; [`warp`]: feature alignment; [`consistent`]: all models.
+//! - [`morph`], [`wavelet`]: spatial, multi-target and wavelet-domain morphs.
 
+pub mod adaptive;
 pub mod brent;
+pub mod consistent;
 pub mod kernel;
 pub mod layout;
+pub mod morph;
 pub mod partition;
 pub mod patch_param;
 pub mod remesh;
 pub mod stretch;
+pub mod warp;
+pub mod wavelet;
 
 pub use layout::{QuadLayout, QuadPatchLayout, QuadSide};
 pub use partition::{PartitionOptions, PartitionResult, PatchMesh, partition_genus0};

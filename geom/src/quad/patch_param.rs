@@ -14,6 +14,7 @@ use crate::error::{Error, Result};
 use crate::linalg::{FixedBoundarySystem, Weights};
 use crate::mesh::VertexId;
 use crate::param::Uv;
+use crate::progress::Progress;
 use crate::simplify::{CollapseHistory, DecimateOptions, decimate};
 
 /// Options of [`base_embedding`] and [`coarse_to_fine`].
@@ -51,6 +52,8 @@ pub struct BaseEmbedding {
 pub struct PatchParamResult {
     /// Unit-square position of every patch vertex.
     pub uv: Vec<Uv>,
+    /// The mean-value map of the whole patch (the reference the stretch is compared with).
+    pub uv_mv: Vec<Uv>,
     pub base_vertices: usize,
     /// Stretch of the base (mean value, optimized) and of the full patch: the mean-value map of
     /// the full patch (the reference) and the final map.
@@ -132,12 +135,13 @@ pub fn base_embedding(patch: &PatchMesh, opts: &QuadParamOptions) -> Result<Base
 ///
 /// # Errors
 /// `Numerical` if a star has an empty kernel (cannot happen for an embedding) or the result
-/// folds.
+/// folds; `Cancelled`.
 pub fn coarse_to_fine(
     patch: &PatchMesh,
     mut base: BaseEmbedding,
     frozen: &[VertexId],
     opts: &QuadParamOptions,
+    progress: &mut dyn Progress,
 ) -> Result<PatchParamResult> {
     let st = &mut base.state;
     for v in frozen {
@@ -149,6 +153,10 @@ pub fn coarse_to_fine(
     let mut link = Vec::new();
     for i in (0..base.from_to.len()).rev() {
         let (u, v) = base.from_to[i];
+        if i % 512 == 0 {
+            progress.check()?;
+            progress.report("parameterize", 1.0 - i as f64 / base.from_to.len().max(1) as f64);
+        }
         for &f in &base.history.rewritten[i] {
             for w in st.faces[f as usize].iter_mut() {
                 if *w == v {
@@ -206,6 +214,7 @@ pub fn coarse_to_fine(
     let stretch_mv = mesh_stretch(&st.pos, &mv, tris.iter().copied());
     Ok(PatchParamResult {
         uv: std::mem::take(&mut st.uv),
+        uv_mv: mv,
         base_vertices: base.base_vertices.len(),
         base_stretch_mv: base.stretch_mv,
         base_stretch_opt: base.stretch_opt,

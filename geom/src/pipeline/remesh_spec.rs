@@ -1,0 +1,191 @@
+//! The spec of a `quad` job over N meshes (`surfmap remesh`, the server's N-mesh jobs):
+//! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}`, validated against
+//! the meshes before any work starts. The first four anchor rows are the partition points, the
+//! rest (and `options.feature_anchors`) are feature points.
+
+use crate::error::{InputError, Result};
+use crate::mesh::VertexId;
+use crate::topology;
+use serde::{Deserialize, Serialize};
+
+/// Most models one job may remesh together.
+pub const MAX_MODELS: usize = 16;
+
+/// The only method of a remesh job.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum QuadMethod {
+    /// Consistent quad parameterization (Yu & Chuang).
+    Quad,
+}
+
+/// Interpolation in time between consecutive models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Interpolation {
+    #[default]
+    Linear,
+    /// Cubic Hermite through the models (Catmull–Rom tangents, zero at the ends).
+    Spline,
+}
+
+/// Where the morph interpolates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum MorphDomain {
+    #[default]
+    Spatial,
+    /// Lifting-wavelet coefficients, each level on its own schedule.
+    Wavelet,
+}
+
+/// When one wavelet level starts to blend (time in [0, 1]) and how fast (1 = over the whole morph).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LevelSchedule {
+    pub start: f64,
+    pub speed: f64,
+}
+
+/// Morph outputs: `morph.glb` always; OBJ frames when `frames > 0`; one OBJ per weight vector.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct MorphOptions {
+    /// OBJ frames `morph_000.obj`, … over t in [0, 1] through the models in order.
+    pub frames: usize,
+    pub interpolation: Interpolation,
+    pub domain: MorphDomain,
+    /// Wavelet schedules, coarsest level first; missing levels get the default (finer levels
+    /// start later and blend faster).
+    pub schedule: Vec<LevelSchedule>,
+    /// Multi-target blends: each a weight per model, written as `blend_<k>.obj`.
+    pub weights: Vec<Vec<f64>>,
+}
+
+/// Options of a `quad` job. Every field has a default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct QuadOptions {
+    /// Uniform remeshing level: `(2^level + 1)²` samples per patch.
+    pub level: u32,
+    /// Adaptive remeshing: refine a quad while its normalized plane-fit error exceeds this
+    /// (consistently over the models); `None` for uniform remeshing.
+    pub adaptive_epsilon: Option<f64>,
+    /// Extra feature rows `[v_1, ..., v_N]` besides anchor rows 5 and on.
+    pub feature_anchors: Vec<Vec<u64>>,
+    pub morph: MorphOptions,
+    /// Interior vertices kept in each patch's base mesh.
+    pub base_vertices: usize,
+    /// Geometry images and normal maps at this level (`None`: `min(level, 8)`); 0 disables them.
+    pub image_level: Option<u32>,
+    /// Surface samples per direction for PSNR / Hausdorff.
+    pub metric_samples: usize,
+}
+
+impl Default for QuadOptions {
+    fn default() -> Self {
+        Self {
+            level: 6,
+            adaptive_epsilon: None,
+            feature_anchors: Vec::new(),
+            morph: MorphOptions::default(),
+            base_vertices: 32,
+            image_level: None,
+            metric_samples: 100_000,
+        }
+    }
+}
+
+/// A `quad` job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RemeshSpec {
+    pub method: QuadMethod,
+    pub anchors: Vec<Vec<u64>>,
+    #[serde(default)]
+    pub options: QuadOptions,
+}
+
+impl RemeshSpec {
+    /// Parses a spec from JSON.
+    ///
+    /// # Errors
+    /// `InputError::Spec` naming the field at fault.
+    pub fn from_json(bytes: &[u8]) -> Result<RemeshSpec> {
+        serde_json::from_slice(bytes).map_err(|e| InputError::Spec(e.to_string()).into())
+    }
+
+    /// Checks the spec against the models' summaries: 2..=16 connected closed genus-0
+    /// meshes, rows one vertex per model, in range, no vertex used twice on one model.
+    /// Returns all rows (partition points first, then features) as vertex ids.
+    ///
+    /// # Errors
+    /// `InputError::TopologyMismatch`, `InputError::Anchors`, `InputError::Spec`.
+    pub fn check(&self, summaries: &[topology::Summary]) -> Result<Vec<Vec<VertexId>>> {
+        let n = summaries.len();
+        if !(1..=MAX_MODELS).contains(&n) {
+            return Err(InputError::Spec(format!("a quad job takes 1 to {MAX_MODELS} meshes, got {n}")).into());
+        }
+        for (m, s) in summaries.iter().enumerate() {
+            if s.components != 1 || s.boundary_loops != 0 || s.genus != 0 {
+                return Err(InputError::TopologyMismatch(format!(
+                    "method quad partitions closed connected genus-0 surfaces; mesh {m} has {} components, {} boundary loops, genus {}",
+                    s.components, s.boundary_loops, s.genus
+                ))
+                .into());
+            }
+        }
+        let o = &self.options;
+        if !(1..=crate::quad::remesh::MAX_LEVEL).contains(&o.level) {
+            return Err(InputError::Spec(format!("level {} is outside 1..={}", o.level, crate::quad::remesh::MAX_LEVEL)).into());
+        }
+        if let Some(e) = o.adaptive_epsilon
+            && !(e.is_finite() && e > 0.0)
+        {
+            return Err(InputError::Spec(format!("adaptive_epsilon must be positive, got {e}")).into());
+        }
+        if o.morph.weights.iter().any(|w| w.len() != n || w.iter().any(|x| !x.is_finite())) {
+            return Err(InputError::Spec(format!("every morph weight vector needs {n} finite weights")).into());
+        }
+        if o.morph.schedule.iter().any(|s| !(s.start.is_finite() && s.speed.is_finite() && s.speed > 0.0)) {
+            return Err(InputError::Spec("wavelet schedules need finite starts and positive speeds".into()).into());
+        }
+        if o.morph.frames > 10_000 {
+            return Err(InputError::Spec(format!("{} morph frames exceed the limit 10000", o.morph.frames)).into());
+        }
+        let rows: Vec<&Vec<u64>> = self.anchors.iter().chain(&o.feature_anchors).collect();
+        if self.anchors.len() < 4 {
+            return Err(InputError::Anchors(format!(
+                "need 4 partition points (the first 4 anchor rows), got {} rows",
+                self.anchors.len()
+            ))
+            .into());
+        }
+        if rows.len() > super::MAX_ANCHORS {
+            return Err(InputError::Anchors(format!("{} anchor rows exceed the limit {}", rows.len(), super::MAX_ANCHORS)).into());
+        }
+        let mut seen = vec![std::collections::HashMap::new(); n];
+        let mut out = Vec::with_capacity(rows.len());
+        for (r, row) in rows.iter().enumerate() {
+            if row.len() != n {
+                return Err(InputError::Anchors(format!("anchor row {r} has {} entries for {n} meshes", row.len())).into());
+            }
+            let mut ids = Vec::with_capacity(n);
+            for (m, &v) in row.iter().enumerate() {
+                if v >= summaries[m].vertices as u64 {
+                    return Err(InputError::Anchors(format!(
+                        "anchor row {r}: vertex {v} is out of range for mesh {m} ({} vertices)",
+                        summaries[m].vertices
+                    ))
+                    .into());
+                }
+                if let Some(j) = seen[m].insert(v, r) {
+                    return Err(InputError::Anchors(format!("anchor rows {j} and {r} repeat vertex {v} of mesh {m}")).into());
+                }
+                ids.push(VertexId(v as u32));
+            }
+            out.push(ids);
+        }
+        Ok(out)
+    }
+}

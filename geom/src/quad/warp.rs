@@ -1,0 +1,152 @@
+//! Foldover-free alignment of feature points in the parameter square (Yu & Chuang, section
+//! 3.4, after Fujimura & Makarov's foldover-free image warping). The warp mesh is the Delaunay
+//! triangulation (spade) of the square's corners and the patch's feature points; every other
+//! free vertex is marshaled into its warp triangle by barycentric coordinates and follows it.
+//! Features move one at a time toward their targets. Where the paper bisects for the moment a
+//! warp triangle would degenerate (an *event*), the area of each triangle around the moving
+//! point is linear in the step, so the event time is solved for exactly; the point stops half
+//! way to it, the warp mesh is re-triangulated (Delaunay removes the collapsing sliver) and the
+//! marshaled vertices are re-located, then the motion resumes. Base-mesh triangles whose
+//! corners fall in different warp triangles can still fold, so a final pass moves the vertices
+//! of any folded triangle to the centroid of their star's kernel.
+
+use super::kernel::kernel_centroid;
+use super::stretch::{ParamState, area2};
+use crate::crossparam::locate2d::barycentric;
+use crate::error::{Error, Result};
+use crate::param::Uv;
+use spade::{DelaunayTriangulation, Point2, Triangulation};
+
+/// Most re-triangulations per feature before the alignment gives up.
+const MAX_EVENTS: usize = 2000;
+
+/// Output of [`align_features`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WarpResult {
+    /// Re-triangulations of the warp mesh (events).
+    pub events: usize,
+    /// Vertices moved to their kernel centroid afterwards to undo folds.
+    pub repaired: usize,
+}
+
+fn delaunay(pts: &[Uv]) -> Result<Vec<[usize; 3]>> {
+    let mut dt: DelaunayTriangulation<Point2<f64>> = DelaunayTriangulation::new();
+    for p in pts {
+        dt.insert(Point2::new(p[0], p[1])).map_err(|e| Error::Numerical(format!("warp mesh: {e}")))?;
+    }
+    if dt.num_vertices() != pts.len() {
+        return Err(Error::Numerical("warp mesh: two feature points coincide in the parameter square".into()));
+    }
+    Ok(dt
+        .inner_faces()
+        .map(|f| {
+            let [a, b, c] = f.vertices().map(|v| v.fix().index());
+            if area2(pts[a], pts[b], pts[c]) < 0.0 { [a, c, b] } else { [a, b, c] }
+        })
+        .collect())
+}
+
+/// Triangle of `tris` containing `p` (largest smallest barycentric coordinate) and the coordinates.
+fn marshal(pts: &[Uv], tris: &[[usize; 3]], p: Uv) -> (usize, [f64; 3]) {
+    let mut best = (f64::NEG_INFINITY, 0, [1.0, 0.0, 0.0]);
+    for (i, t) in tris.iter().enumerate() {
+        let b = barycentric(t.map(|v| pts[v]), p);
+        let m = b[0].min(b[1]).min(b[2]);
+        if m > best.0 {
+            best = (m, i, b);
+        }
+    }
+    (best.1, best.2)
+}
+
+/// Moves each `(vertex, target)` of `state` to its target in the unit square, carrying the
+/// other free vertices along. `corners` are the square's corner vertices.
+///
+/// # Errors
+/// `Numerical` when the warp stalls or a fold cannot be undone.
+pub fn align_features(state: &mut ParamState, corners: [u32; 4], targets: &[(u32, Uv)]) -> Result<WarpResult> {
+    let mut warp_ids: Vec<u32> = corners.to_vec();
+    warp_ids.extend(targets.iter().map(|&(v, _)| v));
+    let movers: Vec<u32> = (0..state.pos.len() as u32)
+        .filter(|&v| state.active[v as usize] && !state.fixed[v as usize] && !warp_ids.contains(&v))
+        .collect();
+    let mut pts: Vec<Uv> = warp_ids.iter().map(|&v| state.uv[v as usize]).collect();
+    let mut events = 0;
+    for (k, &(_, target)) in targets.iter().enumerate() {
+        let w = 4 + k;
+        for step in 0.. {
+            if step >= MAX_EVENTS {
+                return Err(Error::Numerical(format!("feature alignment of feature {k} stalled")));
+            }
+            let tris = delaunay(&pts)?;
+            let places: Vec<(usize, [f64; 3])> =
+                movers.iter().map(|&v| marshal(&pts, &tris, state.uv[v as usize])).collect();
+            let p = pts[w];
+            let d = [target[0] - p[0], target[1] - p[1]];
+            // Largest step before a triangle around w degenerates.
+            let mut t_max = f64::INFINITY;
+            for t in tris.iter().filter(|t| t.contains(&w)) {
+                let r = t.iter().position(|&x| x == w).unwrap_or(0);
+                let (a, b) = (pts[t[(r + 1) % 3]], pts[t[(r + 2) % 3]]);
+                let area = area2(p, a, b);
+                let slope = (a[1] - b[1]) * d[0] + (b[0] - a[0]) * d[1];
+                if slope < 0.0 {
+                    t_max = t_max.min(-area / slope);
+                }
+            }
+            let done = t_max > 1.0;
+            pts[w] = if done { target } else { [p[0] + 0.5 * t_max * d[0], p[1] + 0.5 * t_max * d[1]] };
+            for (i, &v) in movers.iter().enumerate() {
+                let (ti, b) = places[i];
+                let tri = tris[ti];
+                if tri.contains(&w) {
+                    let q = tri.map(|x| pts[x]);
+                    state.uv[v as usize] = [
+                        b[0] * q[0][0] + b[1] * q[1][0] + b[2] * q[2][0],
+                        b[0] * q[0][1] + b[1] * q[1][1] + b[2] * q[2][1],
+                    ];
+                }
+            }
+            events += 1;
+            if done {
+                break;
+            }
+        }
+        state.uv[targets[k].0 as usize] = target;
+    }
+    let repaired = repair_folds(state)?;
+    Ok(WarpResult { events, repaired })
+}
+
+/// Moves the free vertices of folded triangles to their kernel centroids until nothing folds.
+fn repair_folds(state: &mut ParamState) -> Result<usize> {
+    let mut moved = 0;
+    for _ in 0..50 {
+        let mut bad: Vec<u32> = Vec::new();
+        for t in state.live_faces() {
+            if area2(state.uv[t[0] as usize], state.uv[t[1] as usize], state.uv[t[2] as usize]) <= 0.0 {
+                bad.extend(t.iter().copied().filter(|&v| !state.fixed[v as usize]));
+            }
+        }
+        if bad.is_empty() {
+            return Ok(moved);
+        }
+        bad.sort_unstable();
+        bad.dedup();
+        for v in bad {
+            let link: Vec<(Uv, Uv)> = state.vf[v as usize]
+                .iter()
+                .map(|&f| {
+                    let t = state.faces[f as usize];
+                    let r = t.iter().position(|&x| x == v).unwrap_or(0);
+                    (state.uv[t[(r + 1) % 3] as usize], state.uv[t[(r + 2) % 3] as usize])
+                })
+                .collect();
+            if let Some(c) = kernel_centroid(&link) {
+                state.uv[v as usize] = c;
+                moved += 1;
+            }
+        }
+    }
+    Err(Error::Numerical("feature alignment left folded triangles that could not be undone".into()))
+}

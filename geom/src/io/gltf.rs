@@ -69,10 +69,10 @@ pub fn write_glb(base: &[P3], faces: &[[u32; 3]], targets: &[(String, Vec<P3>)])
         "accessors": accessors,
     });
     let mut js = serde_json::to_vec(&doc).unwrap_or_default();
-    while js.len() % 4 != 0 {
+    while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let total = 12 + 8 + js.len() + 8 + bin.len();

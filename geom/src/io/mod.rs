@@ -5,9 +5,9 @@ mod gltf;
 mod lex;
 mod obj;
 mod off;
-mod png16;
 mod ply;
 mod ply_binary;
+mod png16;
 mod stl;
 
 pub use gltf::write_glb;

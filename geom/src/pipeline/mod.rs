@@ -3,13 +3,15 @@
 //! artifacts wherever they keep them.
 
 mod artifacts;
+mod remesh_spec;
 mod run;
 mod run_homology;
-mod remesh_spec;
 mod run_quad;
 mod spec;
 
+pub use remesh_spec::{
+    Interpolation, LevelSchedule, MAX_MODELS, MorphDomain, MorphOptions, QuadMethod, QuadOptions, RemeshSpec,
+};
 pub use run::{Artifact, MapReport, run_map};
-pub use remesh_spec::{Interpolation, LevelSchedule, MAX_MODELS, MorphDomain, MorphOptions, QuadMethod, QuadOptions, RemeshSpec};
 pub use run_quad::{RemeshReport, run_remesh};
 pub use spec::{JobSpec, MAX_ANCHORS, MapOptions, Method};

@@ -137,7 +137,12 @@ impl RemeshSpec {
         }
         let o = &self.options;
         if !(1..=crate::quad::remesh::MAX_LEVEL).contains(&o.level) {
-            return Err(InputError::Spec(format!("level {} is outside 1..={}", o.level, crate::quad::remesh::MAX_LEVEL)).into());
+            return Err(InputError::Spec(format!(
+                "level {} is outside 1..={}",
+                o.level,
+                crate::quad::remesh::MAX_LEVEL
+            ))
+            .into());
         }
         if let Some(e) = o.adaptive_epsilon
             && !(e.is_finite() && e > 0.0)
@@ -162,13 +167,20 @@ impl RemeshSpec {
             .into());
         }
         if rows.len() > super::MAX_ANCHORS {
-            return Err(InputError::Anchors(format!("{} anchor rows exceed the limit {}", rows.len(), super::MAX_ANCHORS)).into());
+            return Err(InputError::Anchors(format!(
+                "{} anchor rows exceed the limit {}",
+                rows.len(),
+                super::MAX_ANCHORS
+            ))
+            .into());
         }
         let mut seen = vec![std::collections::HashMap::new(); n];
         let mut out = Vec::with_capacity(rows.len());
         for (r, row) in rows.iter().enumerate() {
             if row.len() != n {
-                return Err(InputError::Anchors(format!("anchor row {r} has {} entries for {n} meshes", row.len())).into());
+                return Err(
+                    InputError::Anchors(format!("anchor row {r} has {} entries for {n} meshes", row.len())).into()
+                );
             }
             let mut ids = Vec::with_capacity(n);
             for (m, &v) in row.iter().enumerate() {
@@ -180,7 +192,9 @@ impl RemeshSpec {
                     .into());
                 }
                 if let Some(j) = seen[m].insert(v, r) {
-                    return Err(InputError::Anchors(format!("anchor rows {j} and {r} repeat vertex {v} of mesh {m}")).into());
+                    return Err(
+                        InputError::Anchors(format!("anchor rows {j} and {r} repeat vertex {v} of mesh {m}")).into()
+                    );
                 }
                 ids.push(VertexId(v as u32));
             }

@@ -80,7 +80,11 @@ pub struct Remeshes {
 ///
 /// # Errors
 /// Input errors of the spec and meshes, layout conflicts, numerical failures, `Cancelled`.
-pub fn run_remesh(spec: &RemeshSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Result<(RemeshReport, Vec<Artifact>)> {
+pub fn run_remesh(
+    spec: &RemeshSpec,
+    meshes: &[Mesh],
+    progress: &mut dyn Progress,
+) -> Result<(RemeshReport, Vec<Artifact>)> {
     let mut clock = Clock(Instant::now(), Vec::new());
     let summaries: Vec<_> = meshes.iter().map(topology::summary).collect();
     let rows = spec.check(&summaries)?;
@@ -215,11 +219,19 @@ fn mesh_artifacts(cp: &ConsistentResult, rm: &Remeshes) -> Result<Vec<Artifact>>
     for (m, pos) in rm.positions.iter().enumerate() {
         let mesh = Mesh::from_triangles(pos.clone(), &rm.faces)
             .map_err(|e| Error::Internal(format!("remesh {m} is not a valid mesh: {e}")))?;
-        arts.push(Artifact { name: format!("remesh_{m}.obj"), content_type: "model/obj", bytes: io::write(&mesh, Format::Obj) });
+        arts.push(Artifact {
+            name: format!("remesh_{m}.obj"),
+            content_type: "model/obj",
+            bytes: io::write(&mesh, Format::Obj),
+        });
         let model = &cp.models[m];
         let parts: Vec<(&Mesh, &[[f64; 2]])> =
             model.partition.patches.iter().zip(&model.patches).map(|(p, r)| (&p.mesh, r.uv.as_slice())).collect();
-        arts.push(Artifact { name: format!("param_{m}.obj"), content_type: "model/obj", bytes: io::write_obj_uv_patches(&parts) });
+        arts.push(Artifact {
+            name: format!("param_{m}.obj"),
+            content_type: "model/obj",
+            bytes: io::write_obj_uv_patches(&parts),
+        });
     }
     Ok(arts)
 }
@@ -256,8 +268,16 @@ fn geometry_images(cp: &ConsistentResult, level: u32) -> Result<Vec<Artifact>> {
                     nm.push([0, 1, 2].map(|k| (((nor[v][k] + 1.0) * 0.5).clamp(0.0, 1.0) * 65535.0).round() as u16));
                 }
             }
-            arts.push(Artifact { name: format!("geometry_{m}_patch{p}.png"), content_type: "image/png", bytes: io::write_rgb16(side, side, &gi)? });
-            arts.push(Artifact { name: format!("normal_{m}_patch{p}.png"), content_type: "image/png", bytes: io::write_rgb16(side, side, &nm)? });
+            arts.push(Artifact {
+                name: format!("geometry_{m}_patch{p}.png"),
+                content_type: "image/png",
+                bytes: io::write_rgb16(side, side, &gi)?,
+            });
+            arts.push(Artifact {
+                name: format!("normal_{m}_patch{p}.png"),
+                content_type: "image/png",
+                bytes: io::write_rgb16(side, side, &nm)?,
+            });
         }
         boxes.push(json!({"model": m, "bbox_min": lo, "bbox_max": hi}));
     }
@@ -278,18 +298,26 @@ fn geometry_images(cp: &ConsistentResult, level: u32) -> Result<Vec<Artifact>> {
 
 fn morph_artifacts(spec: &RemeshSpec, rm: &Remeshes) -> Result<Vec<Artifact>> {
     let mo = &spec.options.morph;
-    let targets: Vec<(String, Vec<P3>)> = rm.positions[1..].iter().enumerate().map(|(k, p)| (format!("model_{}", k + 1), p.clone())).collect();
-    let mut arts =
-        vec![Artifact { name: "morph.glb".into(), content_type: "model/gltf-binary", bytes: io::write_glb(&rm.positions[0], &rm.faces, &targets) }];
+    let targets: Vec<(String, Vec<P3>)> =
+        rm.positions[1..].iter().enumerate().map(|(k, p)| (format!("model_{}", k + 1), p.clone())).collect();
+    let mut arts = vec![Artifact {
+        name: "morph.glb".into(),
+        content_type: "model/gltf-binary",
+        bytes: io::write_glb(&rm.positions[0], &rm.faces, &targets),
+    }];
     let obj = |pos: Vec<P3>| -> Result<Vec<u8>> {
-        let m = Mesh::from_triangles(pos, &rm.faces).map_err(|e| Error::Internal(format!("morph frame invalid: {e}")))?;
+        let m =
+            Mesh::from_triangles(pos, &rm.faces).map_err(|e| Error::Internal(format!("morph frame invalid: {e}")))?;
         Ok(io::write(&m, Format::Obj))
     };
     if mo.frames > 0 {
         let coefs: Option<Vec<morph::Coefficients>> = match (mo.domain, &rm.grid) {
             (MorphDomain::Wavelet, Some(g)) => Some(rm.positions.iter().map(|p| morph::analyze(g, p)).collect()),
             (MorphDomain::Wavelet, None) => {
-                return Err(crate::InputError::Spec("the wavelet morph needs uniform remeshing (no adaptive_epsilon)".into()).into());
+                return Err(crate::InputError::Spec(
+                    "the wavelet morph needs uniform remeshing (no adaptive_epsilon)".into(),
+                )
+                .into());
             }
             _ => None,
         };
@@ -303,7 +331,11 @@ fn morph_artifacts(spec: &RemeshSpec, rm: &Remeshes) -> Result<Vec<Artifact>> {
         }
     }
     for (k, w) in mo.weights.iter().enumerate() {
-        arts.push(Artifact { name: format!("blend_{k}.obj"), content_type: "model/obj", bytes: obj(morph::blend(&rm.positions, w))? });
+        arts.push(Artifact {
+            name: format!("blend_{k}.obj"),
+            content_type: "model/obj",
+            bytes: obj(morph::blend(&rm.positions, w))?,
+        });
     }
     Ok(arts)
 }

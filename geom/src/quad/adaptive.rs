@@ -75,7 +75,8 @@ pub fn adaptive_remesh_with(
     // Refine by error, patch by patch, carrying each model's vertices down the tree.
     let mut leaves: Vec<Quad> = Vec::new();
     for p in 0..cp.layout.patches.len() {
-        let all: Vec<Vec<u32>> = models.iter().map(|&m| (0..cp.models[m].patches[p].uv.len() as u32).collect()).collect();
+        let all: Vec<Vec<u32>> =
+            models.iter().map(|&m| (0..cp.models[m].patches[p].uv.len() as u32).collect()).collect();
         let mut stack = vec![(Quad { p: p as u32, i: 0, j: 0, s: n }, all)];
         while let Some((q, verts)) = stack.pop() {
             let mut err: f64 = 0.0;
@@ -138,8 +139,7 @@ fn corners(q: &Quad) -> [(u32, u32); 4] {
 /// difference of two or more).
 fn balance(cp: &ConsistentResult, mut leaves: Vec<Quad>, n: u32) -> Vec<Quad> {
     loop {
-        let verts: HashSet<Key> =
-            leaves.iter().flat_map(|q| corners(q).map(|(i, j)| key(cp, q.p, i, j, n))).collect();
+        let verts: HashSet<Key> = leaves.iter().flat_map(|q| corners(q).map(|(i, j)| key(cp, q.p, i, j, n))).collect();
         let mut next = Vec::with_capacity(leaves.len());
         let mut changed = false;
         for q in &leaves {

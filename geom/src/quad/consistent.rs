@@ -55,7 +55,12 @@ pub fn consistent_parameterization(
         return Err(InputError::Anchors(format!("need 4 partition points, got {} anchor rows", rows.len())).into());
     }
     if let Some((r, row)) = rows.iter().enumerate().find(|(_, row)| row.len() != meshes.len()) {
-        return Err(InputError::Anchors(format!("anchor row {r} has {} entries for {} meshes", row.len(), meshes.len())).into());
+        return Err(InputError::Anchors(format!(
+            "anchor row {r} has {} entries for {} meshes",
+            row.len(),
+            meshes.len()
+        ))
+        .into());
     }
     let layout = QuadLayout::genus0();
     let mut partitions = Vec::with_capacity(meshes.len());
@@ -84,8 +89,10 @@ pub fn consistent_parameterization(
             }
         }
     }
-    let mut models: Vec<ModelParam> =
-        partitions.into_iter().map(|partition| ModelParam { partition, patches: Vec::new(), warp: Vec::new() }).collect();
+    let mut models: Vec<ModelParam> = partitions
+        .into_iter()
+        .map(|partition| ModelParam { partition, patches: Vec::new(), warp: Vec::new() })
+        .collect();
     let mut features = vec![(0usize, [0.0; 2]); n_features];
     for p in 0..layout.patches.len() {
         let mut bases = Vec::with_capacity(models.len());

@@ -23,12 +23,23 @@ pub fn spatial(models: &[Vec<P3>], t: f64, interp: Interpolation) -> Vec<P3> {
     }
     let (a, s) = segment(t, n);
     let b = a + 1;
+    // The models themselves at the knots, bit for bit.
+    if s == 0.0 {
+        return models[a].clone();
+    }
+    if s == 1.0 {
+        return models[b].clone();
+    }
     match interp {
         Interpolation::Linear => models[a].iter().zip(&models[b]).map(|(p, q)| p + (q - p) * s).collect(),
         Interpolation::Spline => {
             // Cubic Hermite with Catmull–Rom tangents (one-sided zero at the ends).
-            let (h00, h10, h01, h11) =
-                (2.0 * s.powi(3) - 3.0 * s * s + 1.0, s.powi(3) - 2.0 * s * s + s, -2.0 * s.powi(3) + 3.0 * s * s, s.powi(3) - s * s);
+            let (h00, h10, h01, h11) = (
+                2.0 * s.powi(3) - 3.0 * s * s + 1.0,
+                s.powi(3) - 2.0 * s * s + s,
+                -2.0 * s.powi(3) + 3.0 * s * s,
+                s.powi(3) - s * s,
+            );
             (0..models[a].len())
                 .map(|v| {
                     let p = |k: usize| models[k][v].coords;
@@ -46,7 +57,9 @@ pub fn blend(models: &[Vec<P3>], weights: &[f64]) -> Vec<P3> {
     let sum: f64 = weights.iter().sum();
     let norm = if sum.abs() > 1e-12 { sum } else { 1.0 };
     (0..models[0].len())
-        .map(|v| P3::from(models.iter().zip(weights).map(|(m, w)| m[v].coords * (w / norm)).sum::<nalgebra::Vector3<f64>>()))
+        .map(|v| {
+            P3::from(models.iter().zip(weights).map(|(m, w)| m[v].coords * (w / norm)).sum::<nalgebra::Vector3<f64>>())
+        })
         .collect()
 }
 
@@ -66,7 +79,8 @@ pub fn analyze(grid: &RemeshGrid, pos: &[P3]) -> Coefficients {
         grid.node
             .iter()
             .map(|nd| {
-                let mut x: Vec<[f64; 3]> = nd.iter().map(|&v| [pos[v as usize].x, pos[v as usize].y, pos[v as usize].z]).collect();
+                let mut x: Vec<[f64; 3]> =
+                    nd.iter().map(|&v| [pos[v as usize].x, pos[v as usize].y, pos[v as usize].z]).collect();
                 wavelet::forward(&mut x, grid.n);
                 x
             })

@@ -67,7 +67,9 @@ pub fn partition_genus0(
 ) -> Result<PartitionResult> {
     for (i, p) in points.iter().enumerate() {
         if p.idx() >= mesh.n_vertices() {
-            return Err(InputError::OutOfRange { what: "partition point", index: p.idx(), count: mesh.n_vertices() }.into());
+            return Err(
+                InputError::OutOfRange { what: "partition point", index: p.idx(), count: mesh.n_vertices() }.into()
+            );
         }
         if points[..i].contains(p) || features.contains(p) {
             return Err(InputError::Anchors(format!("partition point {i} (vertex {}) is used twice", p.0)).into());

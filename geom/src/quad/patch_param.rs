@@ -67,8 +67,10 @@ pub struct PatchParamResult {
 
 /// Mean-value embedding of `mesh`'s faces (a sub-soup of `faces`) with fixed boundary values.
 fn mean_value(patch: &PatchMesh, sub: &crate::mesh::Mesh, kept: &[VertexId]) -> Result<Vec<Uv>> {
-    let fixed: Vec<VertexId> =
-        (0..sub.n_vertices()).map(VertexId::from_idx).filter(|v| patch.boundary_uv[kept[v.idx()].idx()].is_some()).collect();
+    let fixed: Vec<VertexId> = (0..sub.n_vertices())
+        .map(VertexId::from_idx)
+        .filter(|v| patch.boundary_uv[kept[v.idx()].idx()].is_some())
+        .collect();
     let value = |v: VertexId| patch.boundary_uv[kept[v.idx()].idx()].unwrap_or([0.5, 0.5]);
     if fixed.len() == sub.n_vertices() {
         return Ok((0..sub.n_vertices()).map(|v| value(VertexId::from_idx(v))).collect());
@@ -76,7 +78,7 @@ fn mean_value(patch: &PatchMesh, sub: &crate::mesh::Mesh, kept: &[VertexId]) -> 
     let mut sys = FixedBoundarySystem::new(sub, &fixed)?;
     let factor = sys.factor(sub, Weights::MeanValue)?;
     let (uv, residual) = factor.solve_with_residual::<2>(&|v| value(v))?;
-    if !(residual < 1e-8) {
+    if residual.is_nan() || residual >= 1e-8 {
         return Err(Error::Numerical(format!("mean-value embedding residual {residual:.2e}")));
     }
     Ok(uv)

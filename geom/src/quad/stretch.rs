@@ -184,8 +184,8 @@ impl ParamState {
             }
             order.sort_by(|a, b| b.0.total_cmp(&a.0));
             let mut max_move: f64 = 0.0;
-            for i in 0..order.len() {
-                let v = order[i].1;
+            let visit: Vec<u32> = order.iter().map(|o| o.1).collect();
+            for v in visit {
                 max_move = max_move.max(self.optimize_vertex(v, opts.directions));
             }
             if max_move < opts.tolerance {
@@ -202,6 +202,8 @@ impl ParamState {
 
     /// Live faces with non-positive parameter area.
     pub fn flipped(&self) -> usize {
-        self.live_faces().filter(|t| area2(self.uv[t[0] as usize], self.uv[t[1] as usize], self.uv[t[2] as usize]) <= 0.0).count()
+        self.live_faces()
+            .filter(|t| area2(self.uv[t[0] as usize], self.uv[t[1] as usize], self.uv[t[2] as usize]) <= 0.0)
+            .count()
     }
 }

@@ -4,11 +4,12 @@
 //! CDF 5/3 predict and update steps) applied separably, because it has the same small support
 //! and exact lifting inverse, and because it can be arranged so that shared patch sides are
 //! transformed identically from either patch:
-//! - at each scale the four sides are transformed first, in 1D along the side (the 5/3 filters
-//!   are symmetric, so the patch on the other side, which walks the side the other way, gets the
-//!   same coefficients);
-//! - then interior rows, then interior columns; no pass ever updates a sample on the patch
-//!   boundary, and a side's samples are only touched by the side's own pass.
+//! - at each scale every row, then every column is lifted (a tensor-product transform); the
+//!   update step never changes a line's two end samples, which lie on the patch boundary;
+//! - so a side (the first or last row or column) is changed only by its own 1D pass, which
+//!   reads only its own samples; the 5/3 filters are symmetric, so the patch across the side,
+//!   which walks it the other way and maybe as a row instead of a column, gets the same
+//!   coefficients.
 //!
 //! Reconstruction of a shared side therefore depends on that side's coefficients alone, and the
 //! patches of a remesh stay watertight whatever each level's blend. Each lifting step is undone
@@ -45,21 +46,13 @@ fn lift(x: &mut [[f64; 3]], idx: &[usize], forward: bool) {
     }
 }
 
-/// The lines of one scale (`s` = grid step): the four sides, interior rows, interior columns.
-fn lines(n: usize, s: usize) -> [Vec<Vec<usize>>; 3] {
+/// The lines of one scale (`s` = grid step): every row, then every column, at that step.
+fn lines(n: usize, s: usize) -> [Vec<Vec<usize>>; 2] {
     let w = n + 1;
-    let at = |i: usize, j: usize| j * w + i;
     let steps: Vec<usize> = (0..=n).step_by(s).collect();
-    let sides = vec![
-        steps.iter().map(|&i| at(i, 0)).collect(),
-        steps.iter().map(|&j| at(n, j)).collect(),
-        steps.iter().map(|&i| at(n - i, n)).collect(),
-        steps.iter().map(|&j| at(0, n - j)).collect(),
-    ];
-    let inner: Vec<usize> = steps.iter().copied().filter(|&k| k != 0 && k != n).collect();
-    let rows = inner.iter().map(|&j| steps.iter().map(|&i| at(i, j)).collect()).collect();
-    let cols = inner.iter().map(|&i| steps.iter().map(|&j| at(i, j)).collect()).collect();
-    [sides, rows, cols]
+    let rows = steps.iter().map(|&j| steps.iter().map(|&i| j * w + i).collect()).collect();
+    let cols = steps.iter().map(|&i| steps.iter().map(|&j| j * w + i).collect()).collect();
+    [rows, cols]
 }
 
 /// In-place forward transform of a `(n + 1)²` grid (row-major, `n` a power of two).
@@ -79,8 +72,8 @@ pub fn forward(x: &mut [[f64; 3]], n: usize) {
 pub fn inverse(x: &mut [[f64; 3]], n: usize) {
     let mut s = n / 2;
     while s >= 1 {
-        let [sides, rows, cols] = lines(n, s);
-        for group in [cols, rows, sides] {
+        let [rows, cols] = lines(n, s);
+        for group in [cols, rows] {
             for l in group {
                 lift(x, &l, false);
             }
@@ -102,7 +95,9 @@ mod tests {
     use super::*;
 
     fn grid(n: usize, seed: f64) -> Vec<[f64; 3]> {
-        (0..(n + 1) * (n + 1)).map(|k| [(k as f64 * seed).sin(), (k as f64 * 0.37).cos() * seed, k as f64 * 1e-3]).collect()
+        (0..(n + 1) * (n + 1))
+            .map(|k| [(k as f64 * seed).sin(), (k as f64 * 0.37).cos() * seed, k as f64 * 1e-3])
+            .collect()
     }
 
     #[test]
@@ -121,7 +116,8 @@ mod tests {
     #[test]
     fn linear_data_has_zero_details_and_sides_transform_alone() {
         let n = 16;
-        let mut x: Vec<[f64; 3]> = (0..(n + 1) * (n + 1)).map(|k| [(k % (n + 1)) as f64, (k / (n + 1)) as f64 * 2.0, 1.0]).collect();
+        let mut x: Vec<[f64; 3]> =
+            (0..(n + 1) * (n + 1)).map(|k| [(k % (n + 1)) as f64, (k / (n + 1)) as f64 * 2.0, 1.0]).collect();
         forward(&mut x, n);
         for j in 0..=n {
             for i in 0..=n {
@@ -137,13 +133,22 @@ mod tests {
         // A side's coefficients depend on that side only.
         let mut a = grid(n, 0.7);
         let mut b = a.clone();
-        for k in (n + 1)..(n + 1) * n {
-            b[k] = [9.0, 9.0, 9.0];
+        for x in &mut b[(n + 1)..(n + 1) * n] {
+            *x = [9.0, 9.0, 9.0];
         }
         forward(&mut a, n);
         forward(&mut b, n);
         for i in 0..=n {
             assert_eq!(a[i], b[i]);
+        }
+        // The same side as a reversed column of another patch gets the same coefficients.
+        let mut c = grid(n, 0.3);
+        for i in 0..=n {
+            c[(n - i) * (n + 1)] = grid(n, 0.7)[i];
+        }
+        forward(&mut c, n);
+        for i in 0..=n {
+            assert_eq!(c[(n - i) * (n + 1)], a[i], "side sample {i}");
         }
         assert_eq!(level(0, 0, n), 0);
         assert_eq!(level(1, 0, n), 4);

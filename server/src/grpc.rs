@@ -72,7 +72,8 @@ impl Surfmap for GrpcApi {
         let r = req.into_inner();
         let spec = parse_spec(r.spec_json.as_bytes())?;
         let key = Some(r.idempotency_key).filter(|k| !k.is_empty());
-        let (j, _) = self.state.service.submit(&o, &r.source, &r.target, &spec, key).await?;
+        let meshes = if r.meshes.is_empty() { vec![r.source, r.target] } else { r.meshes };
+        let (j, _) = self.state.service.submit(&o, &meshes, &spec, key).await?;
         Ok(Response::new(job(&j)))
     }
 

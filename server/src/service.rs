@@ -6,7 +6,7 @@ use crate::views::MeshView;
 use futures::Stream;
 use geom::io::{Format, ReadOptions};
 use geom::mesh::MeshLimits;
-use geom::pipeline::JobSpec;
+use geom::pipeline::Job;
 use std::time::Duration;
 use surfmap_store::{ArtifactRef, BlobStore, JobFilter, JobRecord, JobState, MeshRecord, NewJob, Store, now_ms};
 
@@ -43,7 +43,7 @@ pub struct JobService {
 }
 
 /// The methods a job may name, in the order the docs list them.
-pub const METHODS: [&str; 3] = ["voronoi", "greedy", "homology"];
+pub const METHODS: [&str; 4] = geom::pipeline::METHODS;
 
 fn parse_format(hint: Option<&str>) -> Result<Option<Format>, ApiError> {
     Ok(match hint.map(str::to_ascii_lowercase).as_deref() {
@@ -85,7 +85,7 @@ pub fn job_filter(state: &str, method: &str, cursor: &str, limit: i64) -> Result
 ///
 /// # Errors
 /// `unknown_method` or `invalid_spec` (400).
-pub fn parse_spec(bytes: &[u8]) -> Result<JobSpec, ApiError> {
+pub fn parse_spec(bytes: &[u8]) -> Result<Job, ApiError> {
     let v: serde_json::Value = serde_json::from_slice(bytes)
         .map_err(|e| ApiError::bad_request("invalid_spec", format!("spec is not JSON: {e}")))?;
     match v.get("method") {
@@ -98,7 +98,7 @@ pub fn parse_spec(bytes: &[u8]) -> Result<JobSpec, ApiError> {
         None => return Err(ApiError::bad_request("invalid_spec", "spec has no \"method\"")),
         _ => {}
     }
-    Ok(serde_json::from_value::<JobSpec>(v).map_err(|e| geom::Error::from(geom::InputError::Spec(e.to_string())))?)
+    Ok(Job::from_json(bytes)?)
 }
 
 impl JobService {
@@ -147,7 +147,8 @@ impl JobService {
     }
 
     /// Validates a job against its meshes and queues it. Returns the job and whether it is new
-    /// (false: an earlier request with the same idempotency key).
+    /// (false: an earlier request with the same idempotency key). Pair jobs take
+    /// `[source, target]`; `quad` jobs take 1 to 16 meshes.
     ///
     /// # Errors
     /// 400 bad spec or unknown method; 404 unknown mesh; 422 genus mismatch, bad anchors;
@@ -155,25 +156,43 @@ impl JobService {
     pub async fn submit(
         &self,
         owner: &str,
-        source: &str,
-        target: &str,
-        spec: &JobSpec,
+        meshes: &[String],
+        job: &Job,
         idempotency_key: Option<String>,
     ) -> Result<(JobRecord, bool), ApiError> {
-        let ss = self.summary(owner, "source", source).await?;
-        let ts = self.summary(owner, "target", target).await?;
-        spec.check(&ss, &ts)?;
-        let method = spec.method.name();
-        let job = NewJob {
+        if meshes.is_empty() || meshes.len() > geom::pipeline::MAX_MODELS {
+            return Err(ApiError::bad_request(
+                "invalid_request",
+                format!("a job takes 1 to {} meshes, got {}", geom::pipeline::MAX_MODELS, meshes.len()),
+            ));
+        }
+        let mut summaries = Vec::with_capacity(meshes.len());
+        for (i, id) in meshes.iter().enumerate() {
+            let role = match (meshes.len(), i) {
+                (2, 0) => "source".to_string(),
+                (2, 1) => "target".to_string(),
+                _ => format!("#{i}"),
+            };
+            summaries.push(self.summary(owner, &role, id).await?);
+        }
+        job.check(&summaries)?;
+        let method = job.method();
+        let spec = match job {
+            Job::Map(_) => job.to_json()?,
+            Job::Remesh(s) => {
+                serde_json::to_string(&serde_json::json!({"meshes": meshes, "spec": s})).map_err(ApiError::internal)?
+            }
+        };
+        let new = NewJob {
             owner: owner.to_string(),
             idempotency_key: idempotency_key.filter(|k| !k.is_empty()),
             method: method.to_string(),
-            spec: serde_json::to_string(spec).map_err(ApiError::internal)?,
-            source: source.to_string(),
-            target: target.to_string(),
+            spec,
+            source: meshes[0].clone(),
+            target: meshes[meshes.len() - 1].clone(),
             max_attempts: self.limits.max_attempts,
         };
-        let r = self.store.insert_job(&job).await?;
+        let r = self.store.insert_job(&new).await?;
         if r.1 {
             metrics::counter!("surfmap_jobs_submitted_total", "method" => method).increment(1);
         }

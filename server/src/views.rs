@@ -85,10 +85,17 @@ pub struct ArtifactList {
 #[derive(Debug, Serialize, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SubmitJob {
-    /// Mesh id (sha256) from `POST /v1/meshes`.
-    pub source: String,
-    pub target: String,
-    /// Exactly the spec `surfmap map --spec` takes: `{"method", "anchors", "options"}`.
+    /// Mesh id (sha256) from `POST /v1/meshes` (pair jobs).
+    #[serde(default)]
+    pub source: Option<String>,
+    #[serde(default)]
+    pub target: Option<String>,
+    /// Mesh ids of an N-mesh job (`quad`), in the order of the spec's anchor columns; instead
+    /// of `source` and `target`.
+    #[serde(default)]
+    pub meshes: Option<Vec<String>>,
+    /// Exactly the spec `surfmap map --spec` (or `surfmap remesh --spec`) takes:
+    /// `{"method", "anchors", "options"}`.
     #[schema(value_type = Object)]
     pub spec: serde_json::Value,
 }

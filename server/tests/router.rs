@@ -224,3 +224,68 @@ async fn homology_job_through_the_queue() {
     let e: Value = serde_json::from_slice(&e).unwrap();
     assert_eq!(e["code"], "topology_mismatch", "{e}");
 }
+
+#[tokio::test]
+async fn quad_job_over_three_meshes_through_the_queue() {
+    let t = setup().await;
+    let s = geom::mesh::shapes::icosphere(3);
+    let mut ids = Vec::new();
+    for k in 0..3 {
+        let f = 1.0 + 0.2 * f64::from(k);
+        let m = s
+            .with_positions(s.positions().iter().map(|p| geom::mesh::P3::new(p.x * f, p.y, p.z / f)).collect())
+            .unwrap();
+        let (_, a) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&m, Format::Off))).await;
+        ids.push(a["id"].clone());
+    }
+    // Partition points: four vertices spread over the sphere; one feature point.
+    let qspec = json!({"method": "quad", "anchors": [[0, 0, 0], [1, 1, 1], [2, 2, 2], [3, 3, 3], [40, 40, 40]],
+        "options": {"level": 3, "image_level": 2, "metric_samples": 2000, "morph": {"frames": 2}}});
+    let body = json!({"meshes": ids, "spec": qspec}).to_string();
+    let req = Request::post("/v1/jobs").header("content-type", "application/json").body(Body::from(body)).unwrap();
+    let (st, _, job) = call(&t, req).await;
+    assert_eq!(st, StatusCode::ACCEPTED, "{}", String::from_utf8_lossy(&job));
+    let job: Value = serde_json::from_slice(&job).unwrap();
+    assert_eq!(job["method"], "quad");
+    let id = job["id"].as_str().unwrap().to_string();
+    let (_tx, rx) = tokio::sync::watch::channel(false);
+    assert_eq!(t.worker.run_once(&rx).await.unwrap(), Ran::Ran { job: id.clone(), outcome: "succeeded".into() });
+    let (_, done) = json_call(&t, "GET", &format!("/v1/jobs/{id}"), Body::empty()).await;
+    assert_eq!(done["result"]["models"], 3, "{done}");
+    assert_eq!(done["result"]["feature_points"], 1, "{done}");
+    assert!(done["result"]["feature_uv_error"].as_f64().unwrap() <= 1e-9, "{done}");
+    let (_, list) = json_call(&t, "GET", &format!("/v1/jobs/{id}/artifacts"), Body::empty()).await;
+    let names: Vec<&str> = list["artifacts"].as_array().unwrap().iter().filter_map(|a| a["name"].as_str()).collect();
+    for n in ["remesh_0.obj", "remesh_2.obj", "param_1.obj", "morph.glb", "geometry_2_patch1.png", "metrics.json"] {
+        assert!(names.contains(&n), "{n} missing from {names:?}");
+    }
+    // The same remesh faces for every model.
+    let mut faces = Vec::new();
+    for k in 0..3 {
+        let req = Request::get(format!("/v1/jobs/{id}/artifacts/remesh_{k}.obj")).body(Body::empty()).unwrap();
+        let (st, _, bytes) = call(&t, req).await;
+        assert_eq!(st, StatusCode::OK);
+        faces.push(geom::io::read(&bytes, &Default::default()).unwrap().mesh.faces().to_vec());
+    }
+    assert!(faces[0] == faces[1] && faces[1] == faces[2]);
+    // A pair-form quad job with a torus: refused before queueing, naming the genus.
+    let tor = geom::mesh::shapes::torus(24, 12, 1.0, 0.3);
+    let (_, b) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&tor, Format::Off))).await;
+    let body = json!({"source": ids[0], "target": b["id"], "spec": {"method": "quad", "anchors": [[0, 0], [1, 1], [2, 2], [3, 3]]}});
+    let req = Request::post("/v1/jobs")
+        .header("content-type", "application/json")
+        .body(Body::from(body.to_string()))
+        .unwrap();
+    let (st, _, e) = call(&t, req).await;
+    assert_eq!(st.as_u16(), 422);
+    let e: Value = serde_json::from_slice(&e).unwrap();
+    assert_eq!(e["code"], "topology_mismatch", "{e}");
+    // A voronoi job over three meshes is a bad request.
+    let body = json!({"meshes": ids, "spec": spec()});
+    let req = Request::post("/v1/jobs")
+        .header("content-type", "application/json")
+        .body(Body::from(body.to_string()))
+        .unwrap();
+    let (st, _, e) = call(&t, req).await;
+    assert!(st.is_client_error(), "{st} {}", String::from_utf8_lossy(&e));
+}

@@ -129,6 +129,7 @@ async fn rest_and_grpc(env: &Env) {
         target: tgt.clone(),
         spec_json: spec2.to_string(),
         idempotency_key: "g1".into(),
+        meshes: Vec::new(),
     };
     let j = g.submit_job(req.clone()).await.unwrap().into_inner();
     let again = g.submit_job(req).await.unwrap().into_inner();

@@ -6,7 +6,7 @@ use crate::config::WorkerConfig;
 use crate::progress::Shared;
 use geom::io::ReadOptions;
 use geom::mesh::MeshLimits;
-use geom::pipeline::JobSpec;
+use geom::pipeline::Job;
 use std::time::Instant;
 use surfmap_store::{ArtifactRef, BlobStore, Claim, Heartbeat, Outcome, Store, StoreError};
 use tracing::{info, warn};
@@ -82,9 +82,8 @@ impl Worker {
         };
         let shared = Shared::default();
         let mut progress = shared.clone();
-        let (spec, source, target) = inputs;
-        let mut handle =
-            tokio::task::spawn_blocking(move || geom::pipeline::run_map(&spec, &source, &target, &mut progress));
+        let (spec, meshes) = inputs;
+        let mut handle = tokio::task::spawn_blocking(move || geom::pipeline::run_job(&spec, &meshes, &mut progress));
         let deadline = tokio::time::Instant::now() + self.config.time_limit;
         let mut grace_end: Option<tokio::time::Instant> = None;
         let mut stops = Stops::default();
@@ -130,35 +129,43 @@ impl Worker {
         self.finish(&job.id, fence, &job.method, started, result, &stops).await
     }
 
-    /// Spec and meshes of a job, read under the vertex cap.
-    async fn load(
-        &self,
-        spec: &str,
-        source: &str,
-        target: &str,
-    ) -> Result<(JobSpec, geom::Mesh, geom::Mesh), geom::Error> {
-        let spec = JobSpec::from_json(spec.as_bytes())?;
+    /// Spec and meshes of a job, read under the vertex cap. A pair job stores its spec and its
+    /// source and target; an N-mesh job stores `{"meshes": [id, ...], "spec": {...}}`.
+    async fn load(&self, spec: &str, source: &str, target: &str) -> Result<(Job, Vec<geom::Mesh>), geom::Error> {
+        let stored: serde_json::Value = serde_json::from_str(spec).unwrap_or_default();
+        let ids = stored
+            .get("meshes")
+            .and_then(|m| m.as_array())
+            .map(|a| a.iter().filter_map(|x| x.as_str().map(str::to_string)).collect::<Vec<String>>());
+        let (job, keys) = match (ids, stored.get("spec")) {
+            (Some(ids), Some(inner)) => {
+                let bytes = serde_json::to_vec(inner).map_err(|e| geom::Error::Internal(e.to_string()))?;
+                (Job::from_json(&bytes)?, ids)
+            }
+            _ => (Job::from_json(spec.as_bytes())?, vec![source.to_string(), target.to_string()]),
+        };
         let limits = MeshLimits { max_vertices: self.config.max_vertices, max_faces: 2 * self.config.max_vertices + 8 };
         let read = move |bytes: Vec<u8>| geom::io::read(&bytes, &ReadOptions { limits, hint: None }).map(|r| r.mesh);
-        let mut meshes = Vec::with_capacity(2);
-        for key in [source, target] {
+        let mut pending = Vec::with_capacity(keys.len());
+        for key in &keys {
             let bytes = self
                 .blobs
                 .get(key)
                 .await
                 .map_err(|e| geom::Error::Internal(format!("blob {key}: {e}")))?
                 .ok_or_else(|| geom::Error::Internal(format!("mesh blob {key} is missing from the data dir")))?;
-            meshes.push(tokio::task::spawn_blocking(move || read(bytes)));
+            pending.push(tokio::task::spawn_blocking(move || read(bytes)));
         }
-        let t = meshes.pop().ok_or_else(|| geom::Error::Internal("no target".into()))?;
-        let s = meshes.pop().ok_or_else(|| geom::Error::Internal("no source".into()))?;
-        let join = |r: Result<_, tokio::task::JoinError>| r.map_err(|e| geom::Error::Internal(e.to_string()));
-        Ok((spec, join(s.await)??, join(t.await)??))
+        let mut meshes = Vec::with_capacity(pending.len());
+        for p in pending {
+            meshes.push(p.await.map_err(|e| geom::Error::Internal(e.to_string()))??);
+        }
+        Ok((job, meshes))
     }
 
     async fn store_artifacts(
         &self,
-        report: geom::pipeline::MapReport,
+        report: geom::pipeline::JobOutput,
         artifacts: Vec<geom::pipeline::Artifact>,
     ) -> Result<(String, Vec<ArtifactRef>), geom::Error> {
         let mut refs = Vec::with_capacity(artifacts.len());
@@ -176,7 +183,7 @@ impl Worker {
             metrics::histogram!("surfmap_stage_duration_seconds", "method" => report.method, "stage" => stage.clone())
                 .record(ms / 1e3);
         }
-        let json = serde_json::to_string(&report).map_err(|e| geom::Error::Internal(e.to_string()))?;
+        let json = serde_json::to_string(&report.report).map_err(|e| geom::Error::Internal(e.to_string()))?;
         Ok((json, refs))
     }
 

@@ -3,12 +3,14 @@
 //! artifacts wherever they keep them.
 
 mod artifacts;
+mod job;
 mod remesh_spec;
 mod run;
 mod run_homology;
 mod run_quad;
 mod spec;
 
+pub use job::{Job, JobOutput, METHODS, run_job};
 pub use remesh_spec::{
     Interpolation, LevelSchedule, MAX_MODELS, MorphDomain, MorphOptions, QuadMethod, QuadOptions, RemeshSpec,
 };

@@ -36,8 +36,9 @@ async fn mesh_part(st: &AppState, owner: &str, bytes: &[u8], file_name: Option<S
     Ok(st.service.upload_mesh(owner, bytes.to_vec(), format_hint(file_name.as_deref())).await?.id)
 }
 
-async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<(String, String, Vec<u8>), ApiError> {
+async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<(Vec<String>, Vec<u8>), ApiError> {
     let (mut source, mut target, mut spec) = (None, None, None);
+    let mut meshes = Vec::new();
     while let Some(field) = mp.next_field().await.map_err(multipart_error)? {
         let name = field.name().unwrap_or_default().to_string();
         let file = field.file_name().map(str::to_string);
@@ -46,15 +47,16 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
             "source" => source = Some(mesh_part(st, owner, &bytes, file).await?),
             "target" => target = Some(mesh_part(st, owner, &bytes, file).await?),
             "spec" => spec = Some(bytes.to_vec()),
+            "mesh" => meshes.push(mesh_part(st, owner, &bytes, file).await?),
             other => return Err(ApiError::bad_request("invalid_multipart", format!("unexpected part {other:?}"))),
         }
     }
     let missing = |p: &str| ApiError::bad_request("invalid_multipart", format!("missing part {p:?}"));
-    Ok((
-        source.ok_or_else(|| missing("source"))?,
-        target.ok_or_else(|| missing("target"))?,
-        spec.ok_or_else(|| missing("spec"))?,
-    ))
+    let spec = spec.ok_or_else(|| missing("spec"))?;
+    if !meshes.is_empty() {
+        return Ok((meshes, spec));
+    }
+    Ok((vec![source.ok_or_else(|| missing("source"))?, target.ok_or_else(|| missing("target"))?], spec))
 }
 
 /// Validates a job against its meshes and queues it.
@@ -67,7 +69,7 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
         (status = 422, description = "genus mismatch, anchors out of range", body = ErrorBody)))]
 pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Request) -> Result<Response, ApiError> {
     let key = req.headers().get("idempotency-key").and_then(|v| v.to_str().ok()).map(str::to_string);
-    let (source, target, spec) = if is_multipart(req.headers()) {
+    let (meshes, spec) = if is_multipart(req.headers()) {
         let mp = Multipart::from_request(req, &st)
             .await
             .map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;
@@ -75,12 +77,26 @@ pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Re
     } else {
         let (parts, body) = req.into_parts();
         let bytes = read_limited(&parts.headers, body, st.service.limits.max_body_bytes).await?;
-        let s: SubmitJob = serde_json::from_slice(&bytes)
-            .map_err(|e| ApiError::bad_request("invalid_request", format!("expected {{source, target, spec}}: {e}")))?;
-        (s.source, s.target, serde_json::to_vec(&s.spec).map_err(ApiError::internal)?)
+        let s: SubmitJob = serde_json::from_slice(&bytes).map_err(|e| {
+            ApiError::bad_request(
+                "invalid_request",
+                format!("expected {{source, target, spec}} or {{meshes, spec}}: {e}"),
+            )
+        })?;
+        let meshes = match (s.meshes, s.source, s.target) {
+            (Some(m), None, None) => m,
+            (None, Some(a), Some(b)) => vec![a, b],
+            _ => {
+                return Err(ApiError::bad_request(
+                    "invalid_request",
+                    "give either \"source\" and \"target\" or \"meshes\"",
+                ));
+            }
+        };
+        (meshes, serde_json::to_vec(&s.spec).map_err(ApiError::internal)?)
     };
     let spec = parse_spec(&spec)?;
-    let (job, created) = st.service.submit(&owner, &source, &target, &spec, key).await?;
+    let (job, created) = st.service.submit(&owner, &meshes, &spec, key).await?;
     let mut headers = HeaderMap::new();
     if let Ok(v) = HeaderValue::from_str(&format!("/v1/jobs/{}", job.id)) {
         headers.insert(header::LOCATION, v);

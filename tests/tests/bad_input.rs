@@ -126,6 +126,7 @@ async fn every_class_of_bad_input_gets_a_clear_4xx() {
         target: t.into(),
         spec_json: spec.to_string(),
         idempotency_key: String::new(),
+        meshes: Vec::new(),
     };
     let e = g.submit_job(req(&magic, woman)).await.unwrap_err();
     assert_eq!(

@@ -5,7 +5,7 @@
 //! (u, v) exactly, in the same patch on every model, or the job stops with a typed error.
 
 use super::layout::QuadLayout;
-use super::partition::{PartitionOptions, PartitionResult, partition_genus0};
+use super::partition::{PartitionOptions, PartitionResult, partition_genus0_sided};
 use super::patch_param::{PatchParamResult, QuadParamOptions, base_embedding, coarse_to_fine};
 use super::warp::{WarpResult, align_features};
 use crate::error::{InputError, Result};
@@ -63,13 +63,25 @@ pub fn consistent_parameterization(
         .into());
     }
     let layout = QuadLayout::genus0();
-    let mut partitions = Vec::with_capacity(meshes.len());
+    let mut partitions: Vec<PartitionResult> = Vec::with_capacity(meshes.len());
+    let mut want: Option<Vec<usize>> = None;
     for (m, mesh) in meshes.iter().enumerate() {
         progress.check()?;
         progress.report("partition", m as f64 / meshes.len() as f64);
         let points = [rows[0][m], rows[1][m], rows[2][m], rows[3][m]];
         let features: Vec<VertexId> = rows[4..].iter().map(|r| r[m]).collect();
-        partitions.push(partition_genus0(mesh, points, &features, &opts.partition)?);
+        let part = partition_genus0_sided(mesh, points, &features, want.as_deref(), &opts.partition)?;
+        if want.is_none() {
+            // Model 0 decides which patch each feature belongs to.
+            let mut w = vec![0; features.len()];
+            for (p, patch) in part.patches.iter().enumerate() {
+                for &(k, _) in &patch.features {
+                    w[k] = p;
+                }
+            }
+            want = Some(w);
+        }
+        partitions.push(part);
     }
     // Each feature's patch, the same on every model.
     let n_features = rows.len() - 4;

@@ -19,10 +19,11 @@ pub mod morph;
 pub mod partition;
 pub mod patch_param;
 pub mod remesh;
+pub mod sides;
 pub mod stretch;
 pub mod warp;
 pub mod wavelet;
 
 pub use layout::{QuadLayout, QuadPatchLayout, QuadSide};
-pub use partition::{PartitionOptions, PartitionResult, PatchMesh, partition_genus0};
+pub use partition::{PartitionOptions, PartitionResult, PatchMesh, partition_genus0, partition_genus0_sided};
 pub use patch_param::{BaseEmbedding, PatchParamResult, QuadParamOptions, base_embedding, coarse_to_fine};

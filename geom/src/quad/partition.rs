@@ -65,6 +65,22 @@ pub fn partition_genus0(
     features: &[VertexId],
     opts: &PartitionOptions,
 ) -> Result<PartitionResult> {
+    partition_genus0_sided(mesh, points, features, None, opts)
+}
+
+/// [`partition_genus0`] with the patch each feature must fall in (`want[k]` = 0 or 1, as
+/// on another model): curves that pass a feature on the wrong side are re-traced around it
+/// ([`super::sides::reroute`]).
+///
+/// # Errors
+/// As [`partition_genus0`]; `LayoutConflict` when a feature cannot be brought to its side.
+pub fn partition_genus0_sided(
+    mesh: &Mesh,
+    points: [VertexId; 4],
+    features: &[VertexId],
+    want: Option<&[usize]>,
+    opts: &PartitionOptions,
+) -> Result<PartitionResult> {
     for (i, p) in points.iter().enumerate() {
         if p.idx() >= mesh.n_vertices() {
             return Err(
@@ -78,17 +94,44 @@ pub fn partition_genus0(
     let mut refined = Refined::identity(mesh);
     for round in 0..=opts.max_subdivisions {
         if let Some(curves) = trace_loop(&refined.mesh, points, features)? {
-            return finish(refined, curves, points, features, round);
+            match want {
+                None => return finish(refined, curves, points, features, round),
+                Some(w) => {
+                    if let Some(curves) = fix_sides(&refined.mesh, curves, features, w)? {
+                        return finish(refined, curves, points, features, round);
+                    }
+                }
+            }
         }
         if round < opts.max_subdivisions {
             refined = refined.subdivide()?;
         }
     }
     Err(InputError::LayoutConflict(format!(
-        "the partition points cannot be joined by disjoint paths p0->p1->p2->p3->p0 (after {} subdivisions)",
+        "the partition points cannot be joined by disjoint paths p0->p1->p2->p3->p0{} (after {} subdivisions)",
+        if want.is_some() { " that keep every feature on its side" } else { "" },
         opts.max_subdivisions
     ))
     .into())
+}
+
+/// Re-traces curves until every feature lies in its wanted patch; `None` if that fails.
+fn fix_sides(
+    mesh: &Mesh,
+    mut curves: Vec<Vec<VertexId>>,
+    features: &[VertexId],
+    want: &[usize],
+) -> Result<Option<Vec<Vec<VertexId>>>> {
+    for _ in 0..2 * features.len() + 1 {
+        let left = super::sides::left_faces(mesh, &curves)?;
+        let wrong = features.iter().zip(want).find(|&(&f, &p)| super::sides::vertex_left(mesh, &left, f) != (p == 0));
+        let Some((&f, _)) = wrong else { return Ok(Some(curves)) };
+        match super::sides::reroute(mesh, &curves, f, features)? {
+            Some(c) => curves = c,
+            None => return Ok(None),
+        }
+    }
+    Ok(None)
 }
 
 /// The four paths, or `None` when one is walled off by the ones before.
@@ -230,4 +273,58 @@ fn extract_patch(
     let features =
         features.iter().enumerate().filter_map(|(i, &f)| find(f).map(|l| (i, l))).collect::<Vec<(usize, VertexId)>>();
     Ok(PatchMesh { mesh: pmesh, parent, boundary_uv, corners: lc, features })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+    use crate::topology::euler_characteristic;
+
+    fn extreme(m: &Mesh, dir: [f64; 3]) -> VertexId {
+        let d = nalgebra::Vector3::from(dir);
+        let i = (0..m.n_vertices())
+            .max_by(|&a, &b| m.positions()[a].coords.dot(&d).total_cmp(&m.positions()[b].coords.dot(&d)));
+        VertexId::from_idx(i.unwrap_or(0))
+    }
+
+    #[test]
+    fn sphere_splits_into_two_quads_with_fixed_square_boundaries() {
+        let m = shapes::icosphere(3);
+        let pts = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]].map(|d| extreme(&m, d));
+        let r = partition_genus0(&m, pts, &[], &Default::default()).unwrap();
+        assert_eq!(r.patches.len(), 2);
+        let total: usize = r.patches.iter().map(|p| p.mesh.n_faces()).sum();
+        assert_eq!(total, r.refined.mesh.n_faces(), "the patches cover the surface once");
+        for p in &r.patches {
+            assert_eq!(euler_characteristic(&p.mesh), 1, "a disk");
+            for (k, c) in p.corners.iter().enumerate() {
+                assert_eq!(p.boundary_uv[c.idx()], Some(SQUARE[k]));
+            }
+            // Every boundary vertex is on the square's boundary, every interior one is free.
+            for v in 0..p.mesh.n_vertices() {
+                let b = p.mesh.is_boundary_vertex(VertexId::from_idx(v));
+                assert_eq!(b, p.boundary_uv[v].is_some());
+                if let Some([u, w]) = p.boundary_uv[v] {
+                    assert!(u == 0.0 || u == 1.0 || w == 0.0 || w == 1.0);
+                }
+            }
+            // No triangle with three boundary corners (it would be flat in the square).
+            for t in p.mesh.faces() {
+                assert!(t.iter().any(|v| p.boundary_uv[v.idx()].is_none()));
+            }
+        }
+    }
+
+    #[test]
+    fn a_feature_is_brought_to_the_wanted_side() {
+        let m = shapes::icosphere(4);
+        let pts = [[1.0, 0.0, 0.1], [0.0, 1.0, 0.0], [-1.0, 0.0, -0.1], [0.0, -1.0, 0.0]].map(|d| extreme(&m, d));
+        let f = extreme(&m, [0.3, 0.3, 1.0]);
+        let r = partition_genus0(&m, pts, &[f], &Default::default()).unwrap();
+        let side = r.patches.iter().position(|p| !p.features.is_empty()).unwrap();
+        let r2 = partition_genus0_sided(&m, pts, &[f], Some(&[1 - side]), &Default::default()).unwrap();
+        assert_eq!(r2.patches[1 - side].features.len(), 1, "rerouted around the feature");
+        assert!(r2.patches[side].features.is_empty());
+    }
 }

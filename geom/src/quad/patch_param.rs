@@ -225,3 +225,68 @@ pub fn coarse_to_fine(
         flipped,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{P3, shapes};
+    use crate::progress::NoProgress;
+
+    /// A bumpy square as a patch, its boundary fixed where it lies.
+    fn bumpy_patch(n: usize, feature: Option<usize>) -> PatchMesh {
+        let g = shapes::grid(n);
+        let pos: Vec<P3> = g
+            .positions()
+            .iter()
+            .map(|p| P3::new(p.x, p.y, 0.6 * (-((p.x - 0.3).powi(2) + (p.y - 0.6).powi(2)) * 30.0).exp()))
+            .collect();
+        let mesh = g.with_positions(pos).unwrap();
+        let boundary_uv = (0..mesh.n_vertices())
+            .map(|v| {
+                let p = g.positions()[v];
+                mesh.is_boundary_vertex(VertexId::from_idx(v)).then_some([p.x, p.y])
+            })
+            .collect();
+        let id = |i: usize, j: usize| VertexId::from_idx(j * (n + 1) + i);
+        PatchMesh {
+            parent: (0..mesh.n_vertices()).map(VertexId::from_idx).collect(),
+            mesh,
+            boundary_uv,
+            corners: [id(0, 0), id(n, 0), id(n, n), id(0, n)],
+            features: feature.map(|f| vec![(0, VertexId::from_idx(f))]).unwrap_or_default(),
+        }
+    }
+
+    #[test]
+    fn coarse_to_fine_lowers_stretch_without_folds() {
+        let p = bumpy_patch(24, None);
+        let opts = QuadParamOptions::default();
+        let base = base_embedding(&p, &opts).unwrap();
+        assert!(base.base_vertices.len() < p.mesh.n_vertices() / 4, "a coarse base mesh");
+        assert!(base.stretch_opt.0 <= base.stretch_mv.0, "{:?} {:?}", base.stretch_opt, base.stretch_mv);
+        let r = coarse_to_fine(&p, base, &[], &opts, &mut NoProgress).unwrap();
+        assert_eq!(r.flipped, 0);
+        assert!(r.stretch_final.0 < r.stretch_mv.0, "{:?} vs {:?}", r.stretch_final, r.stretch_mv);
+        for (v, b) in p.boundary_uv.iter().enumerate() {
+            if let Some(b) = b {
+                assert_eq!(r.uv[v], *b, "boundary stays fixed");
+            }
+        }
+    }
+
+    #[test]
+    fn an_aligned_feature_lands_exactly_and_nothing_folds() {
+        let f = 13 * 25 + 11;
+        let p = bumpy_patch(24, Some(f));
+        let opts = QuadParamOptions::default();
+        let mut base = base_embedding(&p, &opts).unwrap();
+        let target = [0.62, 0.41];
+        let w =
+            super::super::warp::align_features(&mut base.state, p.corners.map(|c| c.0), &[(f as u32, target)]).unwrap();
+        assert!(w.events >= 1);
+        assert_eq!(base.state.flipped(), 0);
+        let r = coarse_to_fine(&p, base, &[VertexId::from_idx(f)], &opts, &mut NoProgress).unwrap();
+        assert_eq!(r.uv[f], target);
+        assert_eq!(r.flipped, 0);
+    }
+}

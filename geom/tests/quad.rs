@@ -191,3 +191,47 @@ fn bad_quad_jobs_get_typed_errors() {
     }
     assert!(RemeshSpec::from_json(br#"{"method": "voronoi", "anchors": []}"#).is_err());
 }
+
+#[test]
+fn genus_one_pair_gets_quads_from_the_voronoi_layout() {
+    let a = load("rocker_arm/rocker-arm2500.off");
+    let (lo, hi) = a.bbox();
+    let r = (hi.y - lo.y) * 1.2;
+    let cy = (lo.y + hi.y) / 2.0;
+    let bent: Vec<geom::mesh::P3> = a
+        .positions()
+        .iter()
+        .map(|p| {
+            let u = (p.y - cy) / r;
+            geom::mesh::P3::new(p.x, cy + r * u.sin(), p.z + r * (1.0 - u.cos()))
+        })
+        .collect();
+    let b = a.with_positions(bent).unwrap();
+    let ids = fps(&a, 24);
+    let rows: Vec<[u32; 2]> = ids.iter().map(|&i| [i, i]).collect();
+    let sp = spec(
+        json!({"method": "quad", "anchors": rows, "options": {"level": 3, "image_level": 2, "metric_samples": 20000}}),
+    );
+    let (rep, arts) = run_remesh(&sp, &[a.clone(), b.clone()], &mut NoProgress).expect("genus-1 quad");
+    let r0 = read_obj(artifact(&arts, "remesh_0.obj"));
+    let r1 = read_obj(artifact(&arts, "remesh_1.obj"));
+    assert_eq!(r0.faces(), r1.faces());
+    let s = summary(&r0);
+    assert_eq!((s.components, s.boundary_loops, s.genus), (1, 0, 1), "{s:?}");
+    assert_eq!(rep.patches % 3, 0, "three quads per layout triangle");
+    for m in &rep.per_model {
+        for p in &m.patches {
+            assert_eq!(p.flipped_uv, 0);
+        }
+        assert!(m.psnr_db > 40.0, "{}", m.psnr_db);
+    }
+    // Every anchor is a quad corner: some remesh vertex sits exactly on it, on both models.
+    let diag = a.bbox_diagonal();
+    for (mesh, rm) in [(&a, &r0), (&b, &r1)] {
+        for &i in &ids {
+            let p = mesh.position(geom::VertexId(i));
+            let d = rm.positions().iter().map(|q| (q - p).norm()).fold(f64::INFINITY, f64::min);
+            assert!(d <= 1e-9 * diag, "anchor {i}: {d}");
+        }
+    }
+}

@@ -115,8 +115,8 @@ impl RemeshSpec {
         serde_json::from_slice(bytes).map_err(|e| InputError::Spec(e.to_string()).into())
     }
 
-    /// Checks the spec against the models' summaries: 2..=16 connected closed genus-0
-    /// meshes, rows one vertex per model, in range, no vertex used twice on one model.
+    /// Checks the spec against the models' summaries: 1..=16 connected closed meshes of one
+    /// genus, rows one vertex per model, in range, no vertex used twice on one model.
     /// Returns all rows (partition points first, then features) as vertex ids.
     ///
     /// # Errors
@@ -127,10 +127,17 @@ impl RemeshSpec {
             return Err(InputError::Spec(format!("a quad job takes 1 to {MAX_MODELS} meshes, got {n}")).into());
         }
         for (m, s) in summaries.iter().enumerate() {
-            if s.components != 1 || s.boundary_loops != 0 || s.genus != 0 {
+            if s.components != 1 || s.boundary_loops != 0 {
                 return Err(InputError::TopologyMismatch(format!(
-                    "method quad partitions closed connected genus-0 surfaces; mesh {m} has {} components, {} boundary loops, genus {}",
-                    s.components, s.boundary_loops, s.genus
+                    "method quad partitions closed connected surfaces; mesh {m} has {} components and {} boundary loops",
+                    s.components, s.boundary_loops
+                ))
+                .into());
+            }
+            if s.genus != summaries[0].genus {
+                return Err(InputError::TopologyMismatch(format!(
+                    "genus mismatch: mesh 0 has genus {}, mesh {m} genus {}",
+                    summaries[0].genus, s.genus
                 ))
                 .into());
             }
@@ -163,6 +170,14 @@ impl RemeshSpec {
             return Err(InputError::Anchors(format!(
                 "need 4 partition points (the first 4 anchor rows), got {} rows",
                 self.anchors.len()
+            ))
+            .into());
+        }
+        if summaries[0].genus > 0 && rows.len() < 6 {
+            return Err(InputError::Anchors(format!(
+                "genus {} needs at least 6 anchor rows for its triangle layout, got {}",
+                summaries[0].genus,
+                rows.len()
             ))
             .into());
         }

@@ -12,7 +12,8 @@ use crate::progress::Progress;
 use crate::quad::consistent::{ConsistentOptions, ConsistentResult, consistent_parameterization};
 use crate::quad::remesh::{RemeshGrid, sample_uniform, sample_with_normals, uniform_grid};
 use crate::quad::stretch::mesh_stretch;
-use crate::quad::{PartitionOptions, QuadParamOptions, adaptive, morph};
+use crate::quad::surface::{PatchSurface, QuadSurface};
+use crate::quad::{PartitionOptions, QuadLayout, QuadParamOptions, adaptive, morph, tri_quads};
 use crate::topology;
 use serde::Serialize;
 use serde_json::json;
@@ -76,6 +77,115 @@ pub struct Remeshes {
     pub grid: Option<RemeshGrid>,
 }
 
+/// A `quad` job's quads on every model, whatever built them, and what the build measured.
+pub struct Built<'a> {
+    pub layout: QuadLayout,
+    pub surfaces: Vec<Box<dyn QuadSurface + 'a>>,
+    /// Per model: patch reports, stretch (start, final), partition subdivisions.
+    pub patches: Vec<Vec<PatchReport>>,
+    pub stretch: Vec<([f64; 2], [f64; 2])>,
+    pub subdivisions: Vec<usize>,
+    /// Per model: `param_<i>.obj`.
+    pub params: Vec<Vec<u8>>,
+    pub feature_points: usize,
+    pub feature_uv_error: f64,
+}
+
+/// The genus-0 build: partition, consistent parameterization, feature alignment.
+fn build_genus0<'a>(cp: &'a ConsistentResult) -> Result<Built<'a>> {
+    let mut feature_uv_error: f64 = 0.0;
+    for model in &cp.models {
+        for (p, patch) in model.partition.patches.iter().enumerate() {
+            for &(k, v) in &patch.features {
+                let (fp, t) = cp.features[k];
+                let q = model.patches[p].uv[v.idx()];
+                let e = if fp == p { ((q[0] - t[0]).powi(2) + (q[1] - t[1]).powi(2)).sqrt() } else { f64::INFINITY };
+                feature_uv_error = feature_uv_error.max(e);
+            }
+        }
+    }
+    let mut b = Built {
+        layout: cp.layout.clone(),
+        surfaces: Vec::new(),
+        patches: Vec::new(),
+        stretch: Vec::new(),
+        subdivisions: Vec::new(),
+        params: Vec::new(),
+        feature_points: cp.features.len(),
+        feature_uv_error,
+    };
+    for model in &cp.models {
+        let uvs: Vec<&[[f64; 2]]> = model.patches.iter().map(|p| p.uv.as_slice()).collect();
+        b.surfaces.push(Box::new(PatchSurface::new(&model.partition.patches, uvs)));
+        let mut reports = Vec::new();
+        let (mut pos, mut uv_mv, mut uv, mut tris) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (p, r) in model.patches.iter().enumerate() {
+            let pm = &model.partition.patches[p].mesh;
+            reports.push(PatchReport {
+                vertices: pm.n_vertices(),
+                base_vertices: r.base_vertices,
+                stretch_mv: [r.stretch_mv.0, r.stretch_mv.1],
+                stretch: [r.stretch_final.0, r.stretch_final.1],
+                flipped_uv: r.flipped,
+                warp_events: model.warp[p].events,
+                warp_repaired: model.warp[p].repaired,
+            });
+            let off = pos.len() as u32;
+            pos.extend_from_slice(pm.positions());
+            uv.extend_from_slice(&r.uv);
+            uv_mv.extend_from_slice(&r.uv_mv);
+            tris.extend(pm.face_indices().iter().map(|t| t.map(|v| v + off)));
+        }
+        let s_mv = mesh_stretch(&pos, &uv_mv, tris.iter().copied());
+        let s = mesh_stretch(&pos, &uv, tris.iter().copied());
+        b.patches.push(reports);
+        b.stretch.push(([s_mv.0, s_mv.1], [s.0, s.1]));
+        b.subdivisions.push(model.partition.subdivisions);
+        let parts: Vec<(&Mesh, &[[f64; 2]])> =
+            model.partition.patches.iter().zip(&model.patches).map(|(p, r)| (&p.mesh, r.uv.as_slice())).collect();
+        b.params.push(io::write_obj_uv_patches(&parts));
+    }
+    Ok(b)
+}
+
+/// The higher-genus build: the `voronoi` layout's triangles, three quads each.
+fn build_tri(tq: &tri_quads::TriQuads, rows: usize) -> Built<'_> {
+    let mut b = Built {
+        layout: tq.layout.clone(),
+        surfaces: Vec::new(),
+        patches: Vec::new(),
+        stretch: Vec::new(),
+        subdivisions: Vec::new(),
+        params: Vec::new(),
+        feature_points: rows.saturating_sub(4),
+        // Every anchor is a quad corner on every model.
+        feature_uv_error: 0.0,
+    };
+    for m in &tq.models {
+        b.surfaces.push(Box::new(m));
+        b.patches.push(
+            m.params
+                .iter()
+                .zip(&m.stretch)
+                .map(|(p, (s0, s1))| PatchReport {
+                    vertices: p.local.n_vertices(),
+                    base_vertices: 0,
+                    stretch_mv: [s0.0, s0.1],
+                    stretch: [s1.0, s1.1],
+                    flipped_uv: crate::param::check_injective(&p.local, &p.uv).flipped,
+                    warp_events: 0,
+                    warp_repaired: 0,
+                })
+                .collect(),
+        );
+        b.stretch.push(([m.total.0.0, m.total.0.1], [m.total.1.0, m.total.1.1]));
+        b.subdivisions.push(0);
+        let parts: Vec<(&Mesh, &[[f64; 2]])> = m.params.iter().map(|p| (&p.local, p.uv.as_slice())).collect();
+        b.params.push(io::write_obj_uv_patches(&parts));
+    }
+    b
+}
+
 /// Runs a `quad` job over `meshes`.
 ///
 /// # Errors
@@ -90,23 +200,31 @@ pub fn run_remesh(
     let rows = spec.check(&summaries)?;
     let o = &spec.options;
     clock.lap("setup");
-    let copts = ConsistentOptions {
-        partition: PartitionOptions::default(),
-        param: QuadParamOptions { base_interior: o.base_vertices, ..Default::default() },
-    };
     let refs: Vec<&Mesh> = meshes.iter().collect();
-    let cp = consistent_parameterization(&refs, &rows, &copts, progress)?;
+    let cp;
+    let tq;
+    let built = if summaries[0].genus == 0 {
+        let copts = ConsistentOptions {
+            partition: PartitionOptions::default(),
+            param: QuadParamOptions { base_interior: o.base_vertices, ..Default::default() },
+        };
+        cp = consistent_parameterization(&refs, &rows, &copts, progress)?;
+        build_genus0(&cp)?
+    } else {
+        tq = tri_quads::tri_quads(&refs, &rows, progress)?;
+        build_tri(&tq, rows.len())
+    };
     clock.lap("parameterize");
     progress.check()?;
     progress.report("remesh", 0.0);
-    let rm = remesh_all(&cp, o.level, o.adaptive_epsilon, meshes)?;
+    let rm = remesh_all(&built, o.level, o.adaptive_epsilon, meshes)?;
     clock.lap("remesh");
     let mut arts = Vec::new();
     let image_level = o.image_level.unwrap_or(o.level.min(8));
     if image_level > 0 {
         progress.check()?;
         progress.report("images", 0.0);
-        arts.extend(geometry_images(&cp, image_level)?);
+        arts.extend(geometry_images(&built, image_level)?);
         clock.lap("images");
     }
     progress.check()?;
@@ -115,22 +233,11 @@ pub fn run_remesh(
     for (m, mesh) in meshes.iter().enumerate() {
         progress.check()?;
         progress.report("metrics", m as f64 / meshes.len() as f64);
-        per_model.push(model_report(&cp, m, mesh, &rm, o.metric_samples)?);
+        per_model.push(model_report(&built, m, mesh, &rm, o.metric_samples)?);
     }
     clock.lap("metrics");
-    let mut feature_uv_error: f64 = 0.0;
-    for model in &cp.models {
-        for (p, patch) in model.partition.patches.iter().enumerate() {
-            for &(k, v) in &patch.features {
-                let (fp, t) = cp.features[k];
-                let q = model.patches[p].uv[v.idx()];
-                let e = if fp == p { ((q[0] - t[0]).powi(2) + (q[1] - t[1]).powi(2)).sqrt() } else { f64::INFINITY };
-                feature_uv_error = feature_uv_error.max(e);
-            }
-        }
-    }
     progress.report("morph", 0.0);
-    arts.extend(mesh_artifacts(&cp, &rm)?);
+    arts.extend(mesh_artifacts(&built, &rm)?);
     arts.extend(morph_artifacts(spec, &rm)?);
     clock.lap("artifacts");
     let report = RemeshReport {
@@ -138,9 +245,9 @@ pub fn run_remesh(
         models: meshes.len(),
         level: o.level,
         adaptive_epsilon: o.adaptive_epsilon,
-        patches: cp.layout.patches.len(),
-        feature_points: cp.features.len(),
-        feature_uv_error,
+        patches: built.layout.patches.len(),
+        feature_points: built.feature_points,
+        feature_uv_error: built.feature_uv_error,
         remesh_vertices: rm.positions[0].len(),
         remesh_faces: rm.faces.len(),
         remesh_quads: rm.quads,
@@ -157,46 +264,18 @@ pub fn run_remesh(
 ///
 /// # Errors
 /// `Internal` on a layout mismatch.
-pub fn remesh_all(cp: &ConsistentResult, level: u32, epsilon: Option<f64>, meshes: &[Mesh]) -> Result<Remeshes> {
+pub fn remesh_all(b: &Built, level: u32, epsilon: Option<f64>, meshes: &[Mesh]) -> Result<Remeshes> {
+    let surfs: Vec<&dyn QuadSurface> = b.surfaces.iter().map(|s| s.as_ref() as &dyn QuadSurface).collect();
     if let Some(eps) = epsilon {
-        let r = adaptive::adaptive_remesh(cp, meshes, eps, level)?;
+        let r = adaptive::adaptive_remesh(&b.layout, &surfs, meshes, eps, level)?;
         return Ok(Remeshes { faces: r.faces, quads: r.quads, positions: r.positions, grid: None });
     }
-    let grid = uniform_grid(&cp.layout, level)?;
-    let positions = cp
-        .models
-        .iter()
-        .map(|m| {
-            let uvs: Vec<_> = m.patches.iter().map(|p| p.uv.clone()).collect();
-            sample_uniform(&grid, &m.partition.patches, &uvs)
-        })
-        .collect::<Result<Vec<_>>>()?;
+    let grid = uniform_grid(&b.layout, level)?;
+    let positions = surfs.iter().map(|s| sample_uniform(&grid, *s)).collect::<Result<Vec<_>>>()?;
     Ok(Remeshes { faces: grid.faces.clone(), quads: grid.faces.len() / 2, positions, grid: Some(grid) })
 }
 
-fn model_report(cp: &ConsistentResult, m: usize, mesh: &Mesh, rm: &Remeshes, samples: usize) -> Result<ModelReport> {
-    let model = &cp.models[m];
-    let mut patches = Vec::new();
-    let (mut pos, mut uv_mv, mut uv, mut tris) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for (p, r) in model.patches.iter().enumerate() {
-        let pm = &model.partition.patches[p].mesh;
-        patches.push(PatchReport {
-            vertices: pm.n_vertices(),
-            base_vertices: r.base_vertices,
-            stretch_mv: [r.stretch_mv.0, r.stretch_mv.1],
-            stretch: [r.stretch_final.0, r.stretch_final.1],
-            flipped_uv: r.flipped,
-            warp_events: model.warp[p].events,
-            warp_repaired: model.warp[p].repaired,
-        });
-        let off = pos.len() as u32;
-        pos.extend_from_slice(pm.positions());
-        uv.extend_from_slice(&r.uv);
-        uv_mv.extend_from_slice(&r.uv_mv);
-        tris.extend(pm.face_indices().iter().map(|t| t.map(|v| v + off)));
-    }
-    let s_mv = mesh_stretch(&pos, &uv_mv, tris.iter().copied());
-    let s = mesh_stretch(&pos, &uv, tris.iter().copied());
+fn model_report(b: &Built, m: usize, mesh: &Mesh, rm: &Remeshes, samples: usize) -> Result<ModelReport> {
     let remesh = Mesh::from_triangles(rm.positions[m].clone(), &rm.faces)
         .map_err(|e| Error::Internal(format!("remesh {m} is not a valid mesh: {e}")))?;
     let h = hausdorff(&remesh, mesh, samples, (1, 2))?;
@@ -204,17 +283,17 @@ fn model_report(cp: &ConsistentResult, m: usize, mesh: &Mesh, rm: &Remeshes, sam
     Ok(ModelReport {
         vertices: mesh.n_vertices(),
         faces: mesh.n_faces(),
-        subdivisions: model.partition.subdivisions,
-        patches,
-        stretch_mv: [s_mv.0, s_mv.1],
-        stretch: [s.0, s.1],
+        subdivisions: b.subdivisions[m],
+        patches: b.patches[m].clone(),
+        stretch_mv: b.stretch[m].0,
+        stretch: b.stretch[m].1,
         psnr_db: 20.0 * (1.0 / (h.rms / diag).max(1e-300)).log10(),
         hausdorff: h.hausdorff / diag,
         rms: h.rms / diag,
     })
 }
 
-fn mesh_artifacts(cp: &ConsistentResult, rm: &Remeshes) -> Result<Vec<Artifact>> {
+fn mesh_artifacts(b: &Built, rm: &Remeshes) -> Result<Vec<Artifact>> {
     let mut arts = Vec::new();
     for (m, pos) in rm.positions.iter().enumerate() {
         let mesh = Mesh::from_triangles(pos.clone(), &rm.faces)
@@ -224,28 +303,20 @@ fn mesh_artifacts(cp: &ConsistentResult, rm: &Remeshes) -> Result<Vec<Artifact>>
             content_type: "model/obj",
             bytes: io::write(&mesh, Format::Obj),
         });
-        let model = &cp.models[m];
-        let parts: Vec<(&Mesh, &[[f64; 2]])> =
-            model.partition.patches.iter().zip(&model.patches).map(|(p, r)| (&p.mesh, r.uv.as_slice())).collect();
-        arts.push(Artifact {
-            name: format!("param_{m}.obj"),
-            content_type: "model/obj",
-            bytes: io::write_obj_uv_patches(&parts),
-        });
+        arts.push(Artifact { name: format!("param_{m}.obj"), content_type: "model/obj", bytes: b.params[m].clone() });
     }
     Ok(arts)
 }
 
 /// One geometry image (positions quantized to 16 bits in the model's bounding box) and one
-/// normal map per patch and model, and `geometry_images.json` with the boxes to dequantize.
-fn geometry_images(cp: &ConsistentResult, level: u32) -> Result<Vec<Artifact>> {
-    let grid = uniform_grid(&cp.layout, level)?;
+/// normal map per quad and model, and `geometry_images.json` with the boxes to dequantize.
+fn geometry_images(b: &Built, level: u32) -> Result<Vec<Artifact>> {
+    let grid = uniform_grid(&b.layout, level)?;
     let side = (grid.n + 1) as u32;
     let mut arts = Vec::new();
     let mut boxes = Vec::new();
-    for (m, model) in cp.models.iter().enumerate() {
-        let uvs: Vec<_> = model.patches.iter().map(|p| p.uv.clone()).collect();
-        let (pos, nor) = sample_with_normals(&grid, &model.partition.patches, &uvs)?;
+    for (m, surf) in b.surfaces.iter().enumerate() {
+        let (pos, nor) = sample_with_normals(&grid, surf.as_ref())?;
         let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
         for p in &pos {
             for k in 0..3 {
@@ -284,7 +355,7 @@ fn geometry_images(cp: &ConsistentResult, level: u32) -> Result<Vec<Artifact>> {
     let doc = json!({
         "level": level,
         "size": side,
-        "patches": cp.layout.patches.len(),
+        "patches": b.layout.patches.len(),
         "encoding": "16-bit RGB; position = bbox_min + pixel / 65535 * (bbox_max - bbox_min); normal = 2 * pixel / 65535 - 1; row 0 is v = 1",
         "models": boxes,
     });

@@ -8,11 +8,12 @@
 //! triangles when no neighbour is finer, otherwise a fan from its centre through the corners and
 //! the midpoints that finer neighbours put on its edges.
 
-use super::consistent::ConsistentResult;
+use super::layout::QuadLayout;
 use super::remesh::{Key, grid_key};
-use crate::crossparam::locate2d::Grid;
+use super::surface::QuadSurface;
 use crate::error::{InputError, Result};
 use crate::mesh::{Mesh, P3};
+use crate::param::Uv;
 use nalgebra::Matrix3;
 use std::collections::{HashMap, HashSet};
 
@@ -57,7 +58,8 @@ fn plane_error(pts: &[P3]) -> f64 {
 /// # Errors
 /// `InputError::Invalid` for a level outside 1..=10.
 pub fn adaptive_remesh_with(
-    cp: &ConsistentResult,
+    layout: &QuadLayout,
+    surfaces: &[&dyn QuadSurface],
     meshes: &[Mesh],
     epsilon: f64,
     max_level: u32,
@@ -69,20 +71,20 @@ pub fn adaptive_remesh_with(
     let n = 1u32 << max_level;
     let models: Vec<usize> = match only {
         Some(m) => vec![m],
-        None => (0..cp.models.len()).collect(),
+        None => (0..surfaces.len()).collect(),
     };
+    let verts_of: Vec<Vec<Vec<(Uv, P3)>>> = surfaces.iter().map(|s| s.vertices()).collect();
     let diag: Vec<f64> = meshes.iter().map(Mesh::bbox_diagonal).collect();
     // Refine by error, patch by patch, carrying each model's vertices down the tree.
     let mut leaves: Vec<Quad> = Vec::new();
-    for p in 0..cp.layout.patches.len() {
-        let all: Vec<Vec<u32>> =
-            models.iter().map(|&m| (0..cp.models[m].patches[p].uv.len() as u32).collect()).collect();
+    #[allow(clippy::needless_range_loop)] // p also names the quad in the tree
+    for p in 0..layout.patches.len() {
+        let all: Vec<Vec<u32>> = models.iter().map(|&m| (0..verts_of[m][p].len() as u32).collect()).collect();
         let mut stack = vec![(Quad { p: p as u32, i: 0, j: 0, s: n }, all)];
         while let Some((q, verts)) = stack.pop() {
             let mut err: f64 = 0.0;
             for (k, &m) in models.iter().enumerate() {
-                let pm = &cp.models[m].partition.patches[p].mesh;
-                let pts: Vec<P3> = verts[k].iter().map(|&v| pm.positions()[v as usize]).collect();
+                let pts: Vec<P3> = verts[k].iter().map(|&v| verts_of[m][p][v as usize].1).collect();
                 err = err.max(plane_error(&pts) / diag[m]);
             }
             if err <= epsilon || q.s == 1 {
@@ -100,12 +102,11 @@ pub fn adaptive_remesh_with(
                     .iter()
                     .enumerate()
                     .map(|(k, &m)| {
-                        let uv = &cp.models[m].patches[p].uv;
                         verts[k]
                             .iter()
                             .copied()
                             .filter(|&v| {
-                                let t = uv[v as usize];
+                                let t = verts_of[m][p][v as usize].0;
                                 t[0] >= lo[0] && t[0] <= hi[0] && t[1] >= lo[1] && t[1] <= hi[1]
                             })
                             .collect()
@@ -115,20 +116,26 @@ pub fn adaptive_remesh_with(
             }
         }
     }
-    let leaves = balance(cp, leaves, n);
-    triangulate(cp, &leaves, n)
+    let leaves = balance(layout, leaves, n);
+    triangulate(layout, surfaces, &leaves, n)
 }
 
 /// [`adaptive_remesh_with`] over all models (consistent adaptive remeshing, `E_C`).
 ///
 /// # Errors
 /// As [`adaptive_remesh_with`].
-pub fn adaptive_remesh(cp: &ConsistentResult, meshes: &[Mesh], epsilon: f64, max_level: u32) -> Result<AdaptiveRemesh> {
-    adaptive_remesh_with(cp, meshes, epsilon, max_level, None)
+pub fn adaptive_remesh(
+    layout: &QuadLayout,
+    surfaces: &[&dyn QuadSurface],
+    meshes: &[Mesh],
+    epsilon: f64,
+    max_level: u32,
+) -> Result<AdaptiveRemesh> {
+    adaptive_remesh_with(layout, surfaces, meshes, epsilon, max_level, None)
 }
 
-fn key(cp: &ConsistentResult, p: u32, i: u32, j: u32, n: u32) -> Key {
-    grid_key(&cp.layout.patches[p as usize], p, i as usize, j as usize, n as usize)
+fn key(layout: &QuadLayout, p: u32, i: u32, j: u32, n: u32) -> Key {
+    grid_key(&layout.patches[p as usize], p, i as usize, j as usize, n as usize)
 }
 
 fn corners(q: &Quad) -> [(u32, u32); 4] {
@@ -137,9 +144,10 @@ fn corners(q: &Quad) -> [(u32, u32); 4] {
 
 /// Splits leaves until no leaf edge carries a neighbour's vertex at a quarter point (a level
 /// difference of two or more).
-fn balance(cp: &ConsistentResult, mut leaves: Vec<Quad>, n: u32) -> Vec<Quad> {
+fn balance(layout: &QuadLayout, mut leaves: Vec<Quad>, n: u32) -> Vec<Quad> {
     loop {
-        let verts: HashSet<Key> = leaves.iter().flat_map(|q| corners(q).map(|(i, j)| key(cp, q.p, i, j, n))).collect();
+        let verts: HashSet<Key> =
+            leaves.iter().flat_map(|q| corners(q).map(|(i, j)| key(layout, q.p, i, j, n))).collect();
         let mut next = Vec::with_capacity(leaves.len());
         let mut changed = false;
         for q in &leaves {
@@ -149,7 +157,7 @@ fn balance(cp: &ConsistentResult, mut leaves: Vec<Quad>, n: u32) -> Vec<Quad> {
                     let (a, b) = (c[e], c[(e + 1) % 4]);
                     [1, 3].iter().any(|&k| {
                         let (i, j) = ((a.0 * (4 - k) + b.0 * k) / 4, (a.1 * (4 - k) + b.1 * k) / 4);
-                        verts.contains(&key(cp, q.p, i, j, n))
+                        verts.contains(&key(layout, q.p, i, j, n))
                     })
                 })
             };
@@ -170,12 +178,12 @@ fn balance(cp: &ConsistentResult, mut leaves: Vec<Quad>, n: u32) -> Vec<Quad> {
     }
 }
 
-fn triangulate(cp: &ConsistentResult, leaves: &[Quad], n: u32) -> Result<AdaptiveRemesh> {
-    let verts: HashSet<Key> = leaves.iter().flat_map(|q| corners(q).map(|(i, j)| key(cp, q.p, i, j, n))).collect();
+fn triangulate(layout: &QuadLayout, surfaces: &[&dyn QuadSurface], leaves: &[Quad], n: u32) -> Result<AdaptiveRemesh> {
+    let verts: HashSet<Key> = leaves.iter().flat_map(|q| corners(q).map(|(i, j)| key(layout, q.p, i, j, n))).collect();
     let mut ids: HashMap<Key, u32> = HashMap::new();
     let mut owner: Vec<(u32, u32, u32)> = Vec::new();
     let mut id = |p: u32, i: u32, j: u32| -> u32 {
-        let k = key(cp, p, i, j, n);
+        let k = key(layout, p, i, j, n);
         *ids.entry(k).or_insert_with(|| {
             owner.push((p, i, j));
             (owner.len() - 1) as u32
@@ -191,7 +199,7 @@ fn triangulate(cp: &ConsistentResult, leaves: &[Quad], n: u32) -> Result<Adaptiv
             let (a, b) = (c[e], c[(e + 1) % 4]);
             if q.s >= 2 {
                 let m = ((a.0 + b.0) / 2, (a.1 + b.1) / 2);
-                if verts.contains(&key(cp, q.p, m.0, m.1, n)) {
+                if verts.contains(&key(layout, q.p, m.0, m.1, n)) {
                     ring.push(m);
                     has_mid = true;
                 }
@@ -216,21 +224,12 @@ fn triangulate(cp: &ConsistentResult, leaves: &[Quad], n: u32) -> Result<Adaptiv
             }
         }
     }
-    let positions = cp
-        .models
+    let positions = surfaces
         .iter()
-        .map(|model| {
-            let tris: Vec<Vec<[u32; 3]>> = model.partition.patches.iter().map(|p| p.mesh.face_indices()).collect();
-            let loc: Vec<Grid> = model.patches.iter().zip(&tris).map(|(r, t)| Grid::new(&r.uv, t)).collect();
+        .map(|surf| {
             owner
                 .iter()
-                .map(|&(p, i, j)| {
-                    let p = p as usize;
-                    let q = [f64::from(i) / f64::from(n), f64::from(j) / f64::from(n)];
-                    let (f, b) = loc[p].locate(&model.patches[p].uv, &tris[p], q);
-                    let x = tris[p][f as usize].map(|v| model.partition.patches[p].mesh.positions()[v as usize]);
-                    P3::from(x[0].coords * b[0] + x[1].coords * b[1] + x[2].coords * b[2])
-                })
+                .map(|&(p, i, j)| surf.sample(p as usize, [f64::from(i) / f64::from(n), f64::from(j) / f64::from(n)]).0)
                 .collect()
         })
         .collect();

@@ -21,6 +21,8 @@ pub mod patch_param;
 pub mod remesh;
 pub mod sides;
 pub mod stretch;
+pub mod surface;
+pub mod tri_quads;
 pub mod warp;
 pub mod wavelet;
 

@@ -3,15 +3,12 @@
 //! Grid points on a patch side are named by their layout curve and their index along it, and
 //! corners by their layout corner, so patches sharing a side share its vertices and the
 //! connectivity depends on the layout and the level alone: identical for every model.
-//! Positions come from point location in each patch's parameterization (a uniform grid over the
-//! parameter triangles), and each shared point is computed once.
+//! Positions come from each model's [`QuadSurface`], and each shared point is computed once.
 
 use super::layout::QuadLayout;
-use super::partition::PatchMesh;
-use crate::crossparam::locate2d::Grid;
+use super::surface::QuadSurface;
 use crate::error::{Error, InputError, Result};
 use crate::mesh::{P3, V3};
-use crate::param::Uv;
 use std::collections::HashMap;
 
 /// Highest remeshing level accepted (level 0 would glue two faces onto two) (`2 · 4^10` triangles per patch).
@@ -120,57 +117,24 @@ pub fn grid_key(pl: &super::layout::QuadPatchLayout, p: u32, i: usize, j: usize,
     }
 }
 
-/// Positions of the remesh vertices of one model, from its patches and their parameterizations.
+/// Positions of the remesh vertices of one model.
 ///
 /// # Errors
-/// `Internal` when the patch count does not match the layout.
-pub fn sample_uniform(grid: &RemeshGrid, patches: &[PatchMesh], uvs: &[Vec<Uv>]) -> Result<Vec<P3>> {
-    Ok(sample(grid, patches, uvs, false)?.0)
+/// `Internal` when the model's quad count does not match the layout.
+pub fn sample_uniform(grid: &RemeshGrid, surf: &dyn QuadSurface) -> Result<Vec<P3>> {
+    Ok(sample_with_normals(grid, surf)?.0)
 }
 
-/// Positions and unit normals (area-weighted vertex normals of the original surface,
-/// interpolated) at the remesh vertices.
+/// Positions and unit normals at the remesh vertices.
 ///
 /// # Errors
 /// As [`sample_uniform`].
-pub fn sample_with_normals(grid: &RemeshGrid, patches: &[PatchMesh], uvs: &[Vec<Uv>]) -> Result<(Vec<P3>, Vec<V3>)> {
-    sample(grid, patches, uvs, true)
-}
-
-fn vertex_normals(m: &crate::Mesh) -> Vec<V3> {
-    let mut n = vec![V3::zeros(); m.n_vertices()];
-    for (f, t) in m.faces().iter().enumerate() {
-        let w = m.face_normal_raw(crate::FaceId::from_idx(f));
-        for v in t {
-            n[v.idx()] += w;
-        }
+pub fn sample_with_normals(grid: &RemeshGrid, surf: &dyn QuadSurface) -> Result<(Vec<P3>, Vec<V3>)> {
+    if surf.n_quads() != grid.node.len() {
+        return Err(Error::Internal(format!("{} quads for a layout of {}", surf.n_quads(), grid.node.len())));
     }
-    n.iter().map(|x| x.try_normalize(0.0).unwrap_or_else(V3::z)).collect()
-}
-
-fn sample(grid: &RemeshGrid, patches: &[PatchMesh], uvs: &[Vec<Uv>], normals: bool) -> Result<(Vec<P3>, Vec<V3>)> {
-    if patches.len() != grid.node.len() || uvs.len() != patches.len() {
-        return Err(Error::Internal(format!("{} patches for a layout of {}", patches.len(), grid.node.len())));
-    }
-    let tris: Vec<Vec<[u32; 3]>> = patches.iter().map(|p| p.mesh.face_indices()).collect();
-    let locators: Vec<Grid> = uvs.iter().zip(&tris).map(|(uv, t)| Grid::new(uv, t)).collect();
-    let vn: Vec<Vec<V3>> = if normals { patches.iter().map(|p| vertex_normals(&p.mesh)).collect() } else { Vec::new() };
     let n = grid.n as f64;
-    let mut pos = Vec::with_capacity(grid.owner.len());
-    let mut nor = Vec::with_capacity(if normals { grid.owner.len() } else { 0 });
-    for &(p, i, j) in &grid.owner {
-        let p = p as usize;
-        let q = [f64::from(i) / n, f64::from(j) / n];
-        let (f, b) = locators[p].locate(&uvs[p], &tris[p], q);
-        let t = tris[p][f as usize];
-        let x = t.map(|v| patches[p].mesh.positions()[v as usize]);
-        pos.push(P3::from(x[0].coords * b[0] + x[1].coords * b[1] + x[2].coords * b[2]));
-        if normals {
-            let m = t.map(|v| vn[p][v as usize]);
-            nor.push((m[0] * b[0] + m[1] * b[1] + m[2] * b[2]).try_normalize(0.0).unwrap_or_else(V3::z));
-        }
-    }
-    Ok((pos, nor))
+    Ok(grid.owner.iter().map(|&(p, i, j)| surf.sample(p as usize, [f64::from(i) / n, f64::from(j) / n])).unzip())
 }
 
 #[cfg(test)]

@@ -15,5 +15,5 @@ pub use remesh_spec::{
     Interpolation, LevelSchedule, MAX_MODELS, MorphDomain, MorphOptions, QuadMethod, QuadOptions, RemeshSpec,
 };
 pub use run::{Artifact, MapReport, run_map};
-pub use run_quad::{RemeshReport, run_remesh};
+pub use run_quad::{RemeshReport, Remeshes, remesh_all_for_bench, run_remesh};
 pub use spec::{JobSpec, MAX_ANCHORS, MapOptions, Method};

@@ -410,3 +410,12 @@ fn morph_artifacts(spec: &RemeshSpec, rm: &Remeshes) -> Result<Vec<Artifact>> {
     }
     Ok(arts)
 }
+
+/// Uniform remeshes of a genus-0 consistent parameterization (for benchmarks).
+///
+/// # Errors
+/// As [`remesh_all`].
+pub fn remesh_all_for_bench(cp: &ConsistentResult, level: u32) -> Result<Remeshes> {
+    let b = build_genus0(cp)?;
+    remesh_all(&b, level, None, &[])
+}

@@ -29,6 +29,9 @@ pub struct PatchReport {
     pub stretch_mv: [f64; 2],
     pub stretch: [f64; 2],
     pub flipped_uv: usize,
+    /// Triangles with zero parameter area (left out of the stretch; only the `voronoi` layout's
+    /// refinement can leave them, with all three corners on one side of a triangle).
+    pub flat_uv: usize,
     pub warp_events: usize,
     pub warp_repaired: usize,
 }
@@ -127,6 +130,7 @@ fn build_genus0<'a>(cp: &'a ConsistentResult) -> Result<Built<'a>> {
                 stretch_mv: [r.stretch_mv.0, r.stretch_mv.1],
                 stretch: [r.stretch_final.0, r.stretch_final.1],
                 flipped_uv: r.flipped,
+                flat_uv: 0,
                 warp_events: model.warp[p].events,
                 warp_repaired: model.warp[p].repaired,
             });
@@ -167,14 +171,18 @@ fn build_tri(tq: &tri_quads::TriQuads, rows: usize) -> Built<'_> {
             m.params
                 .iter()
                 .zip(&m.stretch)
-                .map(|(p, (s0, s1))| PatchReport {
-                    vertices: p.local.n_vertices(),
-                    base_vertices: 0,
-                    stretch_mv: [s0.0, s0.1],
-                    stretch: [s1.0, s1.1],
-                    flipped_uv: crate::param::check_injective(&p.local, &p.uv).flipped,
-                    warp_events: 0,
-                    warp_repaired: 0,
+                .map(|(p, (s0, s1))| {
+                    let inj = crate::param::check_injective(&p.local, &p.uv);
+                    PatchReport {
+                        vertices: p.local.n_vertices(),
+                        base_vertices: 0,
+                        stretch_mv: [s0.0, s0.1],
+                        stretch: [s1.0, s1.1],
+                        flipped_uv: inj.flipped,
+                        flat_uv: inj.degenerate,
+                        warp_events: 0,
+                        warp_repaired: 0,
+                    }
                 })
                 .collect(),
         );

@@ -59,21 +59,26 @@ pub fn triangle_stretch(p: [P3; 3], q: [Uv; 3]) -> Option<(f64, f64)> {
 }
 
 /// Normalized L2 and L∞ stretch of a whole embedding (Sander et al.: parameter area scaled to
-/// the surface area, so 1 is an isometry and larger is worse); `inf` if any triangle folds.
+/// the surface area, so 1 is an isometry and larger is worse). Triangles with no positive
+/// parameter area have no finite stretch and are left out (callers count them separately);
+/// `inf` when no triangle is left.
 pub fn mesh_stretch(pos: &[P3], uv: &[Uv], faces: impl Iterator<Item = [u32; 3]>) -> (f64, f64) {
     let (mut num, mut area3, mut area_uv, mut linf) = (0.0, 0.0, 0.0, 0.0f64);
     for t in faces {
         let p = t.map(|v| pos[v as usize]);
         let q = t.map(|v| uv[v as usize]);
+        let Some((l2, li)) = triangle_stretch(p, q) else { continue };
         let a3 = 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
-        let Some((l2, li)) = triangle_stretch(p, q) else { return (f64::INFINITY, f64::INFINITY) };
         num += l2 * l2 * a3;
         area3 += a3;
         area_uv += area2(q[0], q[1], q[2]) / 2.0;
         linf = linf.max(li);
     }
-    let scale = (area_uv / area3.max(f64::MIN_POSITIVE)).sqrt();
-    ((num / area3.max(f64::MIN_POSITIVE)).sqrt() * scale, linf * scale)
+    if area3 <= 0.0 {
+        return (f64::INFINITY, f64::INFINITY);
+    }
+    let scale = (area_uv / area3).sqrt();
+    ((num / area3).sqrt() * scale, linf * scale)
 }
 
 /// Options of [`ParamState::optimize`].

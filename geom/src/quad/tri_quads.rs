@@ -194,14 +194,14 @@ pub fn tri_quads(meshes: &[&Mesh], rows: &[Vec<VertexId>], progress: &mut dyn Pr
                 fixed,
                 0x5eed + pi as u64,
             );
-            // A start with flat triangles (three corners on one side of the triangle, which the
-            // layout refinement can leave) has no finite stretch: keep it as it is.
-            if st.flipped() == 0 {
-                let all: Vec<u32> = (0..n as u32).collect();
-                st.optimize(&all, &StretchOptOptions::default());
-                if st.flipped() > 0 {
-                    return Err(Error::Internal(format!("stretch optimization of triangle {pi} folded")));
-                }
+            // Flat triangles (three corners on one side of the triangle, which the layout
+            // refinement can leave) have only fixed corners, so they are in no free vertex's star
+            // and the optimization cannot change them; it must not add any.
+            let flat = st.flipped();
+            let all: Vec<u32> = (0..n as u32).collect();
+            st.optimize(&all, &StretchOptOptions::default());
+            if st.flipped() > flat {
+                return Err(Error::Internal(format!("stretch optimization of triangle {pi} folded")));
             }
             let after = mesh_stretch(pp.local.positions(), &st.uv, pp.tris.iter().copied());
             let off = pos.len() as u32;

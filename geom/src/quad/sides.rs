@@ -66,26 +66,57 @@ pub fn reroute(
     }
     let same: Vec<bool> = left.iter().map(|&l| l == side).collect();
     let other: Vec<bool> = left.iter().map(|&l| l != side).collect();
-    // S1: to the nearest curve-interior loop vertex, inside the feature's side.
+    // S1: to the nearest interior vertex of each curve, inside the feature's side, touching no
+    // other loop vertex (else the wall would hang off the loop on both sides).
     let mut blocked = vec![false; n];
     for f in features {
         blocked[f.idx()] = *f != feature;
     }
-    let r1 = vertex_dijkstra(
-        mesh,
-        &[(feature, 0.0)],
-        &VertexDijkstraOptions { faces: Some(&same), blocked: Some(&blocked), ..Default::default() },
-    )?;
-    let Some(w) = (0..n)
-        .filter(|&v| curve_of[v] != u32::MAX && r1.dist[v].is_finite())
-        .min_by(|&a, &b| r1.dist[a].total_cmp(&r1.dist[b]))
-    else {
-        return Ok(None);
-    };
-    let c = curve_of[w] as usize;
+    let mut order = Vec::new();
+    for c in 0..curves.len() {
+        let mut b1 = blocked.clone();
+        for (v, b) in b1.iter_mut().enumerate() {
+            *b |= corner[v] || (curve_of[v] != u32::MAX && curve_of[v] as usize != c);
+        }
+        let r1 = vertex_dijkstra(
+            mesh,
+            &[(feature, 0.0)],
+            &VertexDijkstraOptions { faces: Some(&same), blocked: Some(&b1), ..Default::default() },
+        )?;
+        let best = (0..n)
+            .filter(|&v| curve_of[v] as usize == c && r1.dist[v].is_finite())
+            .min_by(|&a, &b| r1.dist[a].total_cmp(&r1.dist[b]));
+        if let Some(w) = best {
+            order.push((r1.dist[w], c, w, r1));
+        }
+    }
+    order.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (_, c, w, r1) in &order {
+        if let Some(out) = around(mesh, curves, r1, &blocked, &curve_of, &corner, &other, features, *c, *w)? {
+            return Ok(Some(out));
+        }
+    }
+    Ok(None)
+}
+
+/// Re-traces curve `c` with the wall from the feature through `w` (on `c`) to another curve.
+#[allow(clippy::too_many_arguments)]
+fn around(
+    mesh: &Mesh,
+    curves: &[Vec<VertexId>],
+    r1: &crate::geodesic::VertexDijkstraResult,
+    blocked: &[bool],
+    curve_of: &[u32],
+    corner: &[bool],
+    other: &[bool],
+    features: &[VertexId],
+    c: usize,
+    w: usize,
+) -> Result<Option<Vec<Vec<VertexId>>>> {
+    let n = mesh.n_vertices();
     let Some(s1) = r1.path_to(VertexId::from_idx(w)) else { return Ok(None) };
     // S2: from w across to another curve (or a corner not on c), inside the other side.
-    let mut blocked2 = blocked.clone();
+    let mut blocked2 = blocked.to_vec();
     for v in &curves[c] {
         blocked2[v.idx()] = v.idx() != w;
     }
@@ -95,7 +126,7 @@ pub fn reroute(
     let r2 = vertex_dijkstra(
         mesh,
         &[(VertexId::from_idx(w), 0.0)],
-        &VertexDijkstraOptions { faces: Some(&other), blocked: Some(&blocked2), ..Default::default() },
+        &VertexDijkstraOptions { faces: Some(other), blocked: Some(&blocked2), ..Default::default() },
     )?;
     let ends = |v: usize| {
         (curve_of[v] != u32::MAX && curve_of[v] as usize != c)

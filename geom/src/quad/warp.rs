@@ -7,15 +7,20 @@
 //! point is linear in the step, so the event time is solved for exactly; the point stops half
 //! way to it, the warp mesh is re-triangulated (Delaunay removes the collapsing sliver) and the
 //! marshaled vertices are re-located, then the motion resumes. Base-mesh triangles whose
-//! corners fall in different warp triangles can still fold, so a final pass moves the vertices
-//! of any folded triangle to the centroid of their star's kernel.
+//! corners fall in different warp triangles can still fold, so the motion is made in several
+//! equal steps, the carried vertices are relaxed by stretch optimization after each, and the
+//! vertices of any folded triangle are moved to the centroid of their star's kernel.
 
 use super::kernel::kernel_centroid;
-use super::stretch::{ParamState, area2};
+use super::stretch::{ParamState, StretchOptOptions, area2};
 use crate::crossparam::locate2d::barycentric;
 use crate::error::{Error, Result};
 use crate::param::Uv;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
+
+/// The features move to their targets in this many equal steps, the carried vertices relaxed
+/// (stretch optimization, features held) after each, so no step shears the base mesh much.
+const SUBSTEPS: usize = 8;
 
 /// Most re-triangulations per feature before the alignment gives up.
 const MAX_EVENTS: usize = 2000;
@@ -65,6 +70,40 @@ fn marshal(pts: &[Uv], tris: &[[usize; 3]], p: Uv) -> (usize, [f64; 3]) {
 /// # Errors
 /// `Numerical` when the warp stalls or a fold cannot be undone.
 pub fn align_features(state: &mut ParamState, corners: [u32; 4], targets: &[(u32, Uv)]) -> Result<WarpResult> {
+    if targets.is_empty() {
+        return Ok(WarpResult { events: 0, repaired: 0 });
+    }
+    let start: Vec<Uv> = targets.iter().map(|&(v, _)| state.uv[v as usize]).collect();
+    let (mut events, mut repaired) = (0, 0);
+    for s in 1..=SUBSTEPS {
+        let f = s as f64 / SUBSTEPS as f64;
+        let sub: Vec<(u32, Uv)> = targets
+            .iter()
+            .zip(&start)
+            .map(|(&(v, t), p)| {
+                (v, if s == SUBSTEPS { t } else { [p[0] + f * (t[0] - p[0]), p[1] + f * (t[1] - p[1])] })
+            })
+            .collect();
+        events += warp_to(state, corners, &sub)?;
+        repaired += repair_folds(state)?;
+        // Relax the carried vertices with the features held, so the next step starts from a
+        // well-shaped embedding.
+        let held: Vec<bool> = targets.iter().map(|&(v, _)| state.fixed[v as usize]).collect();
+        for &(v, _) in targets {
+            state.fixed[v as usize] = true;
+        }
+        let free: Vec<u32> =
+            (0..state.pos.len() as u32).filter(|&v| state.active[v as usize] && !state.fixed[v as usize]).collect();
+        state.optimize(&free, &StretchOptOptions { max_sweeps: 3, ..Default::default() });
+        for (&(v, _), h) in targets.iter().zip(held) {
+            state.fixed[v as usize] = h;
+        }
+    }
+    Ok(WarpResult { events, repaired })
+}
+
+/// One kinetic warp of every feature to its target; returns the events.
+fn warp_to(state: &mut ParamState, corners: [u32; 4], targets: &[(u32, Uv)]) -> Result<usize> {
     let mut warp_ids: Vec<u32> = corners.to_vec();
     warp_ids.extend(targets.iter().map(|&(v, _)| v));
     let movers: Vec<u32> = (0..state.pos.len() as u32)
@@ -114,8 +153,7 @@ pub fn align_features(state: &mut ParamState, corners: [u32; 4], targets: &[(u32
         }
         state.uv[targets[k].0 as usize] = target;
     }
-    let repaired = repair_folds(state)?;
-    Ok(WarpResult { events, repaired })
+    Ok(events)
 }
 
 /// Moves the free vertices of folded triangles to their kernel centroids until nothing folds.

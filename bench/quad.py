@@ -2,11 +2,13 @@
 """Method `quad` measured like Yu & Chuang's Tables 1-4, on shared meshes, judged with the shared
 evaluator's sampled Hausdorff / RMS (../shared/eval/meshmetrics.py).
 
-usage: python3 bench/quad.py [path/to/surfmap] [uniform|adaptive|consistency] [filter]
+usage: python3 bench/quad.py [path/to/surfmap] [uniform|adaptive|consistency|stretch] [filter]
 
 - uniform: each model alone, levels 1..8: quads, triangles, PSNR (ours and the evaluator's),
   symmetric Hausdorff in % of the bbox diagonal, time (median of 3).
 - adaptive: eps = 0.002, separately (each model alone, SA) and consistently (pairs, CA): faces, PSNR.
+- stretch: every closed shared mesh alone (4 partition points on genus 0, 24 anchors otherwise):
+  L2 / L-inf stretch of the mean-value start and of the result, flips, PSNR at level 6.
 - consistency: pairs with ground truth (SMPL man/woman i<->i, Sumner cat poses i<->i, same-shape
   deformations): identical faces, feature (u, v) error, and the ground-truth error of the remesh
   correspondence (remesh vertex k of model 0, carried to model 1 through the known
@@ -187,12 +189,44 @@ def consistency(binary, filt):
             sys.stdout.flush()
 
 
+GENUS0 = ["cow.off", "horse.off", "cat-low-resolution.obj", "armadillo.obj", "bunny.off", "maxplanck.nf25k.off", "spot.obj",
+          "elephant.obj", "dragon.off", "homer.obj", "landmarks/cat_horse/input0.obj", "landmarks/cat_horse/input1.obj",
+          "landmarks/plane_bird/61.off", "landmarks/plane_bird/248.off", "registered/smpl_human/human_man.obj",
+          "registered/sumner_cat_lion/cat-reference.obj", "registered/sumner_cat_lion/lion-reference.obj"]
+HIGHER = ["torus.obj", "knot.obj", "kitten.nf20k.off", "cow-low-resolution.obj", "rocker_arm/rocker-arm.obj",
+          "rocker_arm/rocker-arm2500.off", "eight.off", "eight_lowres.off", "cup_input_simple_10000.off",
+          "skull_low_resolution.obj", "genus3.off", "3holes.off", "fertility.off", "botijo.off"]
+
+
+def stretch(binary, filt):
+    """Every closed shared mesh alone: normalized stretch of the mean-value start and of the result."""
+    print("| mesh | L2 MV start | L2 final | L∞ MV | L∞ final | flipped | flat | PSNR L6 | time s |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in GENUS0 + HIGHER:
+            if filt not in name:
+                continue
+            p = os.path.join(M, name)
+            k = 0 if name in GENUS0 else 20
+            r = run(binary, tmp, [p], spec_for([p], k, level=6, image_level=0, metric_samples=20000))
+            if "error" in r:
+                print(f"| {name} | {r['error']} |")
+                continue
+            m = r["per_model"][0]
+            fl = sum(x["flipped_uv"] for x in m["patches"])
+            ft = sum(x["flat_uv"] for x in m["patches"])
+            ok = "below" if m["stretch"][0] < m["stretch_mv"][0] else "NOT below"
+            print(f"| {name} | {m['stretch_mv'][0]:.4g} | {m['stretch'][0]:.4f} ({ok}) | {m['stretch_mv'][1]:.4g} | "
+                  f"{m['stretch'][1]:.3f} | {fl} | {ft} | {m['psnr_db']:.2f} | {r['time']:.2f} |")
+            sys.stdout.flush()
+
+
 def main():
     binary = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
         os.environ.get("CARGO_TARGET_DIR", os.path.join(HERE, "..", "target")), "release", "surfmap")
     what = sys.argv[2] if len(sys.argv) > 2 else "uniform"
     filt = sys.argv[3] if len(sys.argv) > 3 else ""
-    {"uniform": uniform, "adaptive": adaptive, "consistency": consistency}[what](binary, filt)
+    {"uniform": uniform, "adaptive": adaptive, "consistency": consistency, "stretch": stretch}[what](binary, filt)
 
 
 if __name__ == "__main__":

@@ -162,15 +162,7 @@ pub fn map(
     let t = read(target)?.mesh;
     let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
     let (report, artifacts) = geom::pipeline::run_map(&spec, &s, &t, &mut progress)?;
-    if progress.tty {
-        eprintln!();
-    }
-    std::fs::create_dir_all(out)
-        .map_err(|e| geom::InputError::Invalid(format!("cannot create {}: {e}", out.display())))?;
-    for a in &artifacts {
-        io::write_bytes(&out.join(&a.name), &a.bytes)?;
-    }
-    serde_json::to_string_pretty(&report).map_err(|e| geom::Error::Internal(e.to_string()))
+    finish(&progress, out, &artifacts, &report)
 }
 
 pub fn remesh(meshes: &[std::path::PathBuf], spec: &Path, out: &Path) -> Result<String> {
@@ -181,13 +173,23 @@ pub fn remesh(meshes: &[std::path::PathBuf], spec: &Path, out: &Path) -> Result<
     let models = meshes.iter().map(|m| read(m).map(|r| r.mesh)).collect::<Result<Vec<_>>>()?;
     let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
     let (report, artifacts) = geom::pipeline::run_remesh(&spec, &models, &mut progress)?;
+    finish(&progress, out, &artifacts, &report)
+}
+
+/// Ends the progress line, writes the artifacts into `out` and returns the report as JSON.
+fn finish(
+    progress: &StderrProgress,
+    out: &Path,
+    artifacts: &[geom::pipeline::Artifact],
+    report: &impl serde::Serialize,
+) -> Result<String> {
     if progress.tty {
         eprintln!();
     }
     std::fs::create_dir_all(out)
         .map_err(|e| geom::InputError::Invalid(format!("cannot create {}: {e}", out.display())))?;
-    for a in &artifacts {
+    for a in artifacts {
         io::write_bytes(&out.join(&a.name), &a.bytes)?;
     }
-    serde_json::to_string_pretty(&report).map_err(|e| geom::Error::Internal(e.to_string()))
+    serde_json::to_string_pretty(report).map_err(|e| geom::Error::Internal(e.to_string()))
 }

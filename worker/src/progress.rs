@@ -7,6 +7,8 @@ use std::sync::{Arc, Mutex};
 /// Where each pipeline stage starts and how much of the job it spans.
 const STAGES: &[(&str, f64, f64)] = &[
     ("layout", 0.0, 0.02),
+    // `quad` jobs: partition -> parameterize -> remesh -> images -> metrics -> morph.
+    ("partition", 0.0, 0.05),
     ("layout_source", 0.02, 0.13),
     ("layout_target", 0.15, 0.2),
     ("layout_greedy", 0.02, 0.33),
@@ -14,7 +16,10 @@ const STAGES: &[(&str, f64, f64)] = &[
     ("parameterize", 0.40, 0.15),
     ("compose", 0.55, 0.05),
     ("smooth", 0.60, 0.20),
+    ("remesh", 0.60, 0.10),
+    ("images", 0.70, 0.10),
     ("metrics", 0.80, 0.18),
+    ("morph", 0.98, 0.02),
     ("done", 1.0, 0.0),
 ];
 

@@ -3,8 +3,10 @@
 //! in different patches and could not be aligned. Given the side a feature must be on, the
 //! curve nearest to it is re-traced around it:
 //! - `S1`: shortest path from the feature to the loop inside its current side, meeting curve `c`
-//!   at `w`;
+//!   at `w` (each curve is tried, nearest first);
 //! - `S2`: shortest path from `w` to another curve, inside the other side;
+//! - neither runs alongside the rest of the loop (they may not enter its one-ring except for
+//!   the last step), so the re-traced curve has room to pass between them and the loop;
 //! - `c` is traced again between its corners with `T = S1 + S2` blocked. The rest of the loop
 //!   and `T` form a tree, whose complement is a disk, so a new `c` exists (on a fine enough
 //!   mesh), and it cannot cross `T`: `T` hangs off the rest of the loop on the wanted side, so
@@ -74,9 +76,11 @@ pub fn reroute(
     }
     let mut order = Vec::new();
     for c in 0..curves.len() {
+        let near = near_rest(mesh, curves, &curve_of, &corner, c);
         let mut b1 = blocked.clone();
         for (v, b) in b1.iter_mut().enumerate() {
-            *b |= corner[v] || (curve_of[v] != u32::MAX && curve_of[v] as usize != c);
+            *b |=
+                corner[v] || (curve_of[v] != u32::MAX && curve_of[v] as usize != c) || (near[v] && v != feature.idx());
         }
         let r1 = vertex_dijkstra(
             mesh,
@@ -87,16 +91,27 @@ pub fn reroute(
             .filter(|&v| curve_of[v] as usize == c && r1.dist[v].is_finite())
             .min_by(|&a, &b| r1.dist[a].total_cmp(&r1.dist[b]));
         if let Some(w) = best {
-            order.push((r1.dist[w], c, w, r1));
+            order.push((r1.dist[w], c, w, r1, near));
         }
     }
     order.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for (_, c, w, r1) in &order {
-        if let Some(out) = around(mesh, curves, r1, &blocked, &curve_of, &corner, &other, features, *c, *w)? {
+    for (_, c, w, r1, near) in &order {
+        if let Some(out) = around(mesh, curves, r1, &blocked, &curve_of, &corner, &other, near, features, *c, *w)? {
             return Ok(Some(out));
         }
     }
     Ok(None)
+}
+
+/// Vertices off the loop next to the loop's other curves or its corners other than `c`'s.
+fn near_rest(mesh: &Mesh, curves: &[Vec<VertexId>], curve_of: &[u32], corner: &[bool], c: usize) -> Vec<bool> {
+    let n = mesh.n_vertices();
+    let rest = |v: usize| {
+        (curve_of[v] != u32::MAX && curve_of[v] as usize != c)
+            || (corner[v] && !curves[c].contains(&VertexId::from_idx(v)))
+    };
+    let on_loop = |v: usize| curve_of[v] != u32::MAX || corner[v];
+    (0..n).map(|v| !on_loop(v) && mesh.vertex_neighbors(VertexId::from_idx(v)).any(|u| rest(u.idx()))).collect()
 }
 
 /// Re-traces curve `c` with the wall from the feature through `w` (on `c`) to another curve.
@@ -109,6 +124,7 @@ fn around(
     curve_of: &[u32],
     corner: &[bool],
     other: &[bool],
+    near: &[bool],
     features: &[VertexId],
     c: usize,
     w: usize,
@@ -132,12 +148,19 @@ fn around(
         (curve_of[v] != u32::MAX && curve_of[v] as usize != c)
             || (corner[v] && !curves[c].contains(&VertexId::from_idx(v)))
     };
-    let Some(z) =
-        (0..n).filter(|&v| ends(v) && r2.dist[v].is_finite()).min_by(|&a, &b| r2.dist[a].total_cmp(&r2.dist[b]))
+    // The first vertex next to the rest of the loop, then one step onto it: the wall never runs
+    // alongside the loop, which would leave no room to pass between them.
+    let Some(y) = (0..n)
+        .filter(|&v| (near[v] || ends(v)) && r2.dist[v].is_finite())
+        .min_by(|&a, &b| r2.dist[a].total_cmp(&r2.dist[b]))
     else {
         return Ok(None);
     };
-    let Some(s2) = r2.path_to(VertexId::from_idx(z)) else { return Ok(None) };
+    let Some(mut s2) = r2.path_to(VertexId::from_idx(y)) else { return Ok(None) };
+    if !ends(y) {
+        let Some(z) = mesh.vertex_neighbors(VertexId::from_idx(y)).find(|u| ends(u.idx())) else { return Ok(None) };
+        s2.push(z);
+    }
     // Re-trace c with everything else blocked.
     let mut wall = vec![false; n];
     for f in features {

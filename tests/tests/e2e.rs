@@ -331,3 +331,43 @@ async fn queued_jobs_survive_a_server_restart() {
         restart(&env).await;
     }
 }
+
+async fn quad_over_rest(env: &Env) {
+    let (mut server, base) = env.server(&["--workers", "1"]);
+    let api = Api::new(&base);
+    let (a, b) = upload_pair(&api).await;
+    // SMPL man and woman: four partition points and two features (same vertex ids on both).
+    let spec = json!({"method": "quad", "anchors": [[0, 0], [6763, 6763], [5905, 5905], [2445, 2445], [1262, 1262], [4716, 4716]],
+        "options": {"level": 5, "image_level": 3, "metric_samples": 20000}});
+    let r =
+        api.req(reqwest::Method::POST, "/v1/jobs").json(&json!({"meshes": [a, b], "spec": spec})).send().await.unwrap();
+    assert_eq!(r.status(), 202);
+    let job: Value = r.json().await.unwrap();
+    let id = job["id"].as_str().unwrap().to_string();
+    let done = api.wait_done(&id, Duration::from_secs(120)).await;
+    assert_eq!(done["state"], "succeeded", "{done}");
+    assert_eq!(done["result"]["models"], 2);
+    assert_eq!(done["result"]["feature_uv_error"], 0.0);
+    let mut faces = Vec::new();
+    for k in 0..2 {
+        let (st, bytes, _) = api.bytes(&format!("/v1/jobs/{id}/artifacts/remesh_{k}.obj")).await;
+        assert_eq!(st, 200);
+        let text = String::from_utf8(bytes).unwrap();
+        faces.push(text.lines().filter(|l| l.starts_with("f ")).map(str::to_string).collect::<Vec<_>>());
+    }
+    assert_eq!(faces[0], faces[1], "identical remesh connectivity");
+    assert_eq!(faces[0].len(), 4 * 32 * 32);
+    let (st, glb, ct) = api.bytes(&format!("/v1/jobs/{id}/artifacts/morph.glb")).await;
+    assert_eq!((st, ct.as_str()), (200, "model/gltf-binary"));
+    assert_eq!(&glb[..4], b"glTF");
+    server.signal("TERM");
+    assert!(server.wait_exit(Duration::from_secs(30)).is_some_and(|s| s.success()), "{}", server.log_text());
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn quad_job_over_rest_with_the_real_binaries() {
+    let _one = ONE_AT_A_TIME.lock().await;
+    for env in Env::all().await {
+        quad_over_rest(&env).await;
+    }
+}

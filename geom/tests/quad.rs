@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{fps, load};
+use common::{bent, fps, load};
 use geom::Mesh;
 use geom::pipeline::{Artifact, RemeshSpec, run_remesh};
 use geom::progress::NoProgress;
@@ -195,18 +195,7 @@ fn bad_quad_jobs_get_typed_errors() {
 #[test]
 fn genus_one_pair_gets_quads_from_the_voronoi_layout() {
     let a = load("rocker_arm/rocker-arm2500.off");
-    let (lo, hi) = a.bbox();
-    let r = (hi.y - lo.y) * 1.2;
-    let cy = (lo.y + hi.y) / 2.0;
-    let bent: Vec<geom::mesh::P3> = a
-        .positions()
-        .iter()
-        .map(|p| {
-            let u = (p.y - cy) / r;
-            geom::mesh::P3::new(p.x, cy + r * u.sin(), p.z + r * (1.0 - u.cos()))
-        })
-        .collect();
-    let b = a.with_positions(bent).unwrap();
+    let b = bent(&a);
     let ids = fps(&a, 24);
     let rows: Vec<[u32; 2]> = ids.iter().map(|&i| [i, i]).collect();
     let sp = spec(

@@ -11,7 +11,7 @@ mod stretch;
 pub use boundary::{BoundaryShape, disk_boundary, map_boundary_to_polygon};
 pub use disk::{DiskParamOptions, DiskParamResult, parameterize_disk};
 pub use injectivity::{InjectivityReport, check_injective};
-pub use stretch::{StretchOptions, StretchResult, face_stretch, minimize_stretch, stretch};
+pub use stretch::{StretchOptions, StretchResult, face_stretch, minimize_stretch, stretch, stretch_jacobian};
 
 /// A 2D point.
 pub type Uv = [f64; 2];

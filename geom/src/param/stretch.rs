@@ -14,7 +14,7 @@
 use super::Uv;
 use crate::error::Result;
 use crate::linalg::{DirectedWeights, FixedBoundarySystem};
-use crate::mesh::{Mesh, VertexId};
+use crate::mesh::{Mesh, P3, V3, VertexId};
 
 /// Options of [`minimize_stretch`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,6 +43,22 @@ pub struct StretchResult {
     pub residual: f64,
 }
 
+/// Sander et al.'s partial derivatives `S_s`, `S_t` of the linear map taking parameter
+/// triangle `q` to surface triangle `p`, with twice the signed parameter area; `None` when that
+/// area vanishes.
+#[inline]
+pub fn stretch_jacobian(p: [P3; 3], q: [Uv; 3]) -> Option<(V3, V3, f64)> {
+    let [q1, q2, q3] = q;
+    let a2 = (q2[0] - q1[0]) * (q3[1] - q1[1]) - (q3[0] - q1[0]) * (q2[1] - q1[1]);
+    if a2.abs() <= f64::MIN_POSITIVE {
+        return None;
+    }
+    let [p1, p2, p3] = p;
+    let ss = (p1.coords * (q2[1] - q3[1]) + p2.coords * (q3[1] - q1[1]) + p3.coords * (q1[1] - q2[1])) / a2;
+    let st = (p1.coords * (q3[0] - q2[0]) + p2.coords * (q1[0] - q3[0]) + p3.coords * (q2[0] - q1[0])) / a2;
+    Some((ss, st, a2))
+}
+
 /// Per-face squared L2 stretch `(|S_s|² + |S_t|²) / 2` of the map uv -> 3D, with uv scaled to
 /// the surface's total area, and each face's 3D area. `None` for a face with no uv area.
 pub fn face_stretch(mesh: &Mesh, uv: &[Uv]) -> (Vec<Option<f64>>, Vec<f64>) {
@@ -55,13 +71,10 @@ pub fn face_stretch(mesh: &Mesh, uv: &[Uv]) -> (Vec<Option<f64>>, Vec<f64>) {
         let a2 = (q2[0] - q1[0]) * (q3[1] - q1[1]) - (q3[0] - q1[0]) * (q2[1] - q1[1]);
         uv_area += 0.5 * a2.abs();
         area.push(0.5 * (p2 - p1).cross(&(p3 - p1)).norm());
-        if a2.abs() <= f64::MIN_POSITIVE {
-            raw.push(None);
-            continue;
-        }
-        let ss = (p1.coords * (q2[1] - q3[1]) + p2.coords * (q3[1] - q1[1]) + p3.coords * (q1[1] - q2[1])) / a2;
-        let st = (p1.coords * (q3[0] - q2[0]) + p2.coords * (q1[0] - q3[0]) + p3.coords * (q2[0] - q1[0])) / a2;
-        raw.push(Some(0.5 * (ss.norm_squared() + st.norm_squared())));
+        raw.push(
+            stretch_jacobian([p1, p2, p3], [q1, q2, q3])
+                .map(|(ss, st, _)| 0.5 * (ss.norm_squared() + st.norm_squared())),
+        );
     }
     // Scaling uv by k scales the squared stretch by 1 / k²: normalise to equal total areas.
     let total: f64 = area.iter().sum();

@@ -11,7 +11,7 @@ use crate::metrics::hausdorff;
 use crate::progress::Progress;
 use crate::quad::consistent::{ConsistentOptions, ConsistentResult, consistent_parameterization};
 use crate::quad::remesh::{RemeshGrid, sample_uniform, sample_with_normals, uniform_grid};
-use crate::quad::stretch::mesh_stretch;
+use crate::quad::stretch::PatchSoup;
 use crate::quad::surface::{PatchSurface, QuadSurface};
 use crate::quad::{PartitionOptions, QuadLayout, QuadParamOptions, adaptive, morph, tri_quads};
 use crate::topology;
@@ -121,7 +121,7 @@ fn build_genus0<'a>(cp: &'a ConsistentResult) -> Result<Built<'a>> {
         let uvs: Vec<&[[f64; 2]]> = model.patches.iter().map(|p| p.uv.as_slice()).collect();
         b.surfaces.push(Box::new(PatchSurface::new(&model.partition.patches, uvs)));
         let mut reports = Vec::new();
-        let (mut pos, mut uv_mv, mut uv, mut tris) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut soup = PatchSoup::default();
         for (p, r) in model.patches.iter().enumerate() {
             let pm = &model.partition.patches[p].mesh;
             reports.push(PatchReport {
@@ -134,14 +134,9 @@ fn build_genus0<'a>(cp: &'a ConsistentResult) -> Result<Built<'a>> {
                 warp_events: model.warp[p].events,
                 warp_repaired: model.warp[p].repaired,
             });
-            let off = pos.len() as u32;
-            pos.extend_from_slice(pm.positions());
-            uv.extend_from_slice(&r.uv);
-            uv_mv.extend_from_slice(&r.uv_mv);
-            tris.extend(pm.face_indices().iter().map(|t| t.map(|v| v + off)));
+            soup.add(pm.positions(), &pm.face_indices(), &r.uv_mv, &r.uv);
         }
-        let s_mv = mesh_stretch(&pos, &uv_mv, tris.iter().copied());
-        let s = mesh_stretch(&pos, &uv, tris.iter().copied());
+        let (s_mv, s) = soup.stretch();
         b.patches.push(reports);
         b.stretch.push(([s_mv.0, s_mv.1], [s.0, s.1]));
         b.subdivisions.push(model.partition.subdivisions);

@@ -152,7 +152,6 @@ pub fn coarse_to_fine(
     let mut n_active = base.base_vertices.len();
     let mut next_global = (n_active as f64 * opts.global_growth).ceil() as usize;
     let mut ring = Vec::new();
-    let mut link = Vec::new();
     for i in (0..base.from_to.len()).rev() {
         let (u, v) = base.from_to[i];
         if i % 512 == 0 {
@@ -176,20 +175,13 @@ pub fn coarse_to_fine(
         }
         st.active[u as usize] = true;
         n_active += 1;
-        link.clear();
         ring.clear();
-        for &f in &st.vf[u as usize] {
-            let t = st.faces[f as usize];
-            let k = t.iter().position(|&w| w == u).unwrap_or(0);
-            let (a, b) = (t[(k + 1) % 3], t[(k + 2) % 3]);
-            link.push((st.uv[a as usize], st.uv[b as usize]));
-            for w in [a, b] {
-                if !ring.contains(&w) {
-                    ring.push(w);
-                }
+        for w in st.link(u).flatten() {
+            if !ring.contains(&w) {
+                ring.push(w);
             }
         }
-        let c = kernel_centroid(&link)
+        let c = kernel_centroid(&st.link_uv(u))
             .ok_or_else(|| Error::Numerical(format!("vertex split {i}: the star of vertex {u} has an empty kernel")))?;
         st.uv[u as usize] = c;
         st.optimize_vertex(u, opts.stretch.directions);

@@ -103,13 +103,15 @@ pub fn reroute(
     Ok(None)
 }
 
+/// Whether `v` is on the loop but not on curve `c`: on another curve, or a corner not `c`'s.
+fn rest_of_loop(curves: &[Vec<VertexId>], curve_of: &[u32], corner: &[bool], c: usize, v: usize) -> bool {
+    (curve_of[v] != u32::MAX && curve_of[v] as usize != c) || (corner[v] && !curves[c].contains(&VertexId::from_idx(v)))
+}
+
 /// Vertices off the loop next to the loop's other curves or its corners other than `c`'s.
 fn near_rest(mesh: &Mesh, curves: &[Vec<VertexId>], curve_of: &[u32], corner: &[bool], c: usize) -> Vec<bool> {
     let n = mesh.n_vertices();
-    let rest = |v: usize| {
-        (curve_of[v] != u32::MAX && curve_of[v] as usize != c)
-            || (corner[v] && !curves[c].contains(&VertexId::from_idx(v)))
-    };
+    let rest = |v: usize| rest_of_loop(curves, curve_of, corner, c, v);
     let on_loop = |v: usize| curve_of[v] != u32::MAX || corner[v];
     (0..n).map(|v| !on_loop(v) && mesh.vertex_neighbors(VertexId::from_idx(v)).any(|u| rest(u.idx()))).collect()
 }
@@ -144,10 +146,7 @@ fn around(
         &[(VertexId::from_idx(w), 0.0)],
         &VertexDijkstraOptions { faces: Some(other), blocked: Some(&blocked2), ..Default::default() },
     )?;
-    let ends = |v: usize| {
-        (curve_of[v] != u32::MAX && curve_of[v] as usize != c)
-            || (corner[v] && !curves[c].contains(&VertexId::from_idx(v)))
-    };
+    let ends = |v: usize| rest_of_loop(curves, curve_of, corner, c, v);
     // The first vertex next to the rest of the loop, then one step onto it: the wall never runs
     // alongside the loop, which would leave no room to pass between them.
     let Some(y) = (0..n)

@@ -11,7 +11,7 @@
 //! mesh replay (`coarse_to_fine`) can add vertices and faces between optimizations.
 
 use crate::mesh::P3;
-use crate::param::Uv;
+use crate::param::{self, Uv};
 use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
@@ -36,23 +36,16 @@ pub fn area2(a: Uv, b: Uv, c: Uv) -> f64 {
     (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
 }
 
-/// `(|S_s|², |S_t|², S_s·S_t, parameter area)` of a triangle, Sander et al.'s eq. for the
-/// Jacobian of the map parameter -> surface.
+/// `(|S_s|², |S_t|², S_s·S_t)` of a positively oriented triangle ([`param::stretch_jacobian`]).
 #[inline]
-fn jacobian(p: [P3; 3], q: [Uv; 3]) -> Option<(f64, f64, f64, f64)> {
-    let a2 = area2(q[0], q[1], q[2]);
-    if a2 <= 0.0 {
-        return None;
-    }
-    let [(s1, t1), (s2, t2), (s3, t3)] = q.map(|x| (x[0], x[1]));
-    let ss = (p[0].coords * (t2 - t3) + p[1].coords * (t3 - t1) + p[2].coords * (t1 - t2)) / a2;
-    let st = (p[0].coords * (s3 - s2) + p[1].coords * (s1 - s3) + p[2].coords * (s2 - s1)) / a2;
-    Some((ss.norm_squared(), st.norm_squared(), ss.dot(&st), a2 / 2.0))
+fn jacobian(p: [P3; 3], q: [Uv; 3]) -> Option<(f64, f64, f64)> {
+    let (ss, st, a2) = param::stretch_jacobian(p, q)?;
+    (a2 > 0.0).then(|| (ss.norm_squared(), st.norm_squared(), ss.dot(&st)))
 }
 
 /// L2 and L∞ stretch of one triangle (`None` when folded or flat in the plane).
 pub fn triangle_stretch(p: [P3; 3], q: [Uv; 3]) -> Option<(f64, f64)> {
-    let (a, c, b, _) = jacobian(p, q)?;
+    let (a, c, b) = jacobian(p, q)?;
     let l2 = ((a + c) / 2.0).sqrt();
     let linf = (((a + c) + ((a - c).powi(2) + 4.0 * b * b).sqrt()) / 2.0).sqrt();
     Some((l2, linf))
@@ -79,6 +72,32 @@ pub fn mesh_stretch(pos: &[P3], uv: &[Uv], faces: impl Iterator<Item = [u32; 3]>
     }
     let scale = (area_uv / area3).sqrt();
     ((num / area3).sqrt() * scale, linf * scale)
+}
+
+/// Several patches' maps before and after an optimization, gathered to measure their stretch
+/// together ([`mesh_stretch`] over all of them).
+#[derive(Debug, Default)]
+pub struct PatchSoup {
+    pos: Vec<P3>,
+    before: Vec<Uv>,
+    after: Vec<Uv>,
+    tris: Vec<[u32; 3]>,
+}
+
+impl PatchSoup {
+    pub fn add(&mut self, pos: &[P3], tris: &[[u32; 3]], before: &[Uv], after: &[Uv]) {
+        let off = self.pos.len() as u32;
+        self.pos.extend_from_slice(pos);
+        self.before.extend_from_slice(before);
+        self.after.extend_from_slice(after);
+        self.tris.extend(tris.iter().map(|t| t.map(|v| v + off)));
+    }
+
+    /// Normalized (L2, L∞) stretch before and after.
+    pub fn stretch(&self) -> ((f64, f64), (f64, f64)) {
+        let s = |uv: &[Uv]| mesh_stretch(&self.pos, uv, self.tris.iter().copied());
+        (s(&self.before), s(&self.after))
+    }
 }
 
 /// Options of [`ParamState::optimize`].
@@ -123,21 +142,33 @@ impl ParamState {
             let x = t.map(|w| self.pos[w as usize]);
             let a3 = 0.5 * (x[1] - x[0]).cross(&(x[2] - x[0])).norm();
             match jacobian(x, q) {
-                Some((a, c, _, _)) => e += a3 * (a + c) / 2.0,
+                Some((a, c, _)) => e += a3 * (a + c) / 2.0,
                 None => return f64::INFINITY,
             }
         }
         e
     }
 
+    /// The link of `u`: per live face around it, its other two corners, counter-clockwise.
+    pub fn link(&self, u: u32) -> impl Iterator<Item = [u32; 2]> + '_ {
+        self.vf[u as usize].iter().map(move |&f| {
+            let t = self.faces[f as usize];
+            let k = t.iter().position(|&w| w == u).unwrap_or(0);
+            [t[(k + 1) % 3], t[(k + 2) % 3]]
+        })
+    }
+
+    /// The link of `u` in the plane, for [`super::kernel::kernel_centroid`].
+    pub fn link_uv(&self, u: u32) -> Vec<(Uv, Uv)> {
+        self.link(u).map(|[a, b]| (self.uv[a as usize], self.uv[b as usize])).collect()
+    }
+
     /// Steps `t` along `d` from the current position that keep every star triangle positive.
     fn feasible(&self, u: u32, d: Uv) -> (f64, f64) {
         let p = self.uv[u as usize];
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-        for &f in &self.vf[u as usize] {
-            let t = self.faces[f as usize];
-            let k = t.iter().position(|&w| w == u).unwrap_or(0);
-            let (a, b) = (self.uv[t[(k + 1) % 3] as usize], self.uv[t[(k + 2) % 3] as usize]);
+        for [a, b] in self.link(u) {
+            let (a, b) = (self.uv[a as usize], self.uv[b as usize]);
             let area = area2(p, a, b);
             // d/dp of area2(p, a, b) = (a_y - b_y, b_x - a_x).
             let slope = (a[1] - b[1]) * d[0] + (b[0] - a[0]) * d[1];

@@ -10,9 +10,9 @@
 //! model (features are aligned by construction).
 
 use super::layout::{QuadLayout, QuadPatchLayout, QuadSide};
-use super::stretch::{ParamState, StretchOptOptions, mesh_stretch};
+use super::stretch::{ParamState, PatchSoup, StretchOptOptions, mesh_stretch};
 use super::surface::{QuadSurface, interpolate, vertex_normals};
-use crate::crossparam::locate2d::Grid;
+use crate::crossparam::locate2d::{Grid, barycentric};
 use crate::crossparam::{PatchParam, PatchParamOptions, TRIANGLE, parameterize_patches};
 use crate::domain::refine::{Refined, refine};
 use crate::domain::tracer::Tracer;
@@ -177,7 +177,7 @@ pub fn tri_quads(meshes: &[&Mesh], rows: &[Vec<VertexId>], progress: &mut dyn Pr
         let refined = refine(t, &patches)?;
         let mut params = parameterize_patches(&refined, &patches, &anchors[m], &popts, progress)?;
         let mut stretch = Vec::with_capacity(params.len());
-        let (mut pos, mut uv0, mut uv1, mut tris) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut soup = PatchSoup::default();
         for (pi, pp) in params.iter_mut().enumerate() {
             progress.report("parameterize", pi as f64 / patches.len() as f64);
             let n = pp.local.n_vertices();
@@ -204,16 +204,12 @@ pub fn tri_quads(meshes: &[&Mesh], rows: &[Vec<VertexId>], progress: &mut dyn Pr
                 return Err(Error::Internal(format!("stretch optimization of triangle {pi} folded")));
             }
             let after = mesh_stretch(pp.local.positions(), &st.uv, pp.tris.iter().copied());
-            let off = pos.len() as u32;
-            pos.extend_from_slice(pp.local.positions());
-            uv0.extend_from_slice(&pp.uv);
-            uv1.extend_from_slice(&st.uv);
-            tris.extend(pp.tris.iter().map(|t| t.map(|v| v + off)));
+            soup.add(pp.local.positions(), &pp.tris, &pp.uv, &st.uv);
             pp.uv = st.uv;
             pp.grid = Grid::new(&pp.uv, &pp.tris);
             stretch.push((before, after));
         }
-        let total = (mesh_stretch(&pos, &uv0, tris.iter().copied()), mesh_stretch(&pos, &uv1, tris.iter().copied()));
+        let total = soup.stretch();
         let normals = vertex_normals(&refined.mesh);
         models.push(TriModel { refined, params, normals, stretch, total });
     }
@@ -235,13 +231,9 @@ impl QuadSurface for &TriModel {
     fn vertices(&self) -> Vec<Vec<(Uv, P3)>> {
         let mut out = vec![Vec::new(); self.n_quads()];
         for (pi, pp) in self.params.iter().enumerate() {
-            let t = TRIANGLE;
-            let area = (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]);
             for (v, u) in pp.uv.iter().enumerate() {
-                // Barycentric coordinates; the quad of the largest one.
-                let l1 = ((u[0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (u[1] - t[0][1])) / area;
-                let l2 = ((t[1][0] - t[0][0]) * (u[1] - t[0][1]) - (u[0] - t[0][0]) * (t[1][1] - t[0][1])) / area;
-                let l = [1.0 - l1 - l2, l1, l2];
+                // The quad of the largest barycentric coordinate.
+                let l = barycentric(TRIANGLE, *u);
                 let k = (0..3).max_by(|&a, &b| l[a].total_cmp(&l[b])).unwrap_or(0);
                 out[3 * pi + k].push((inverse_bilinear(kite(k), *u), pp.local.positions()[v]));
             }

@@ -172,15 +172,7 @@ fn repair_folds(state: &mut ParamState) -> Result<usize> {
         bad.sort_unstable();
         bad.dedup();
         for v in bad {
-            let link: Vec<(Uv, Uv)> = state.vf[v as usize]
-                .iter()
-                .map(|&f| {
-                    let t = state.faces[f as usize];
-                    let r = t.iter().position(|&x| x == v).unwrap_or(0);
-                    (state.uv[t[(r + 1) % 3] as usize], state.uv[t[(r + 2) % 3] as usize])
-                })
-                .collect();
-            if let Some(c) = kernel_centroid(&link) {
+            if let Some(c) = kernel_centroid(&state.link_uv(v)) {
                 state.uv[v as usize] = c;
                 moved += 1;
             }

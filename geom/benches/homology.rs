@@ -31,7 +31,12 @@ fn bench(c: &mut Criterion) {
     }
     let s = load("kitten.nf20k.off");
     let t = bent(&s);
-    let spec = JobSpec { method: Method::Homology, anchors: vec![[0, 0]], options: MapOptions::default() };
+    let spec = JobSpec {
+        method: Method::Homology,
+        anchors: vec![[0, 0]],
+        features: Vec::new(),
+        options: MapOptions::default(),
+    };
     g.bench_function("kitten_bent_genus1_map", |b| b.iter(|| run_map(&spec, &s, &t, &mut NoProgress).expect("map")));
     g.finish();
 }

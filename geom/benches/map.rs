@@ -18,7 +18,7 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("map");
     g.sample_size(10);
     for method in [Method::Voronoi, Method::Greedy] {
-        let spec = JobSpec { method, anchors: anchors.clone(), options: MapOptions::default() };
+        let spec = JobSpec { method, anchors: anchors.clone(), features: Vec::new(), options: MapOptions::default() };
         g.bench_function(format!("armadillo_bent_45_{}", method.name()), |b| {
             b.iter(|| run_map(&spec, &s, &t, &mut NoProgress).expect("map"))
         });
@@ -32,7 +32,7 @@ fn bench(c: &mut Criterion) {
             .expect("decimate");
     let anchors: Vec<[u64; 2]> =
         fps(&coarse.mesh, 45).into_iter().map(|a| [u64::from(coarse.kept[a as usize].0), a]).collect();
-    let spec = JobSpec { method: Method::Voronoi, anchors, options: MapOptions::default() };
+    let spec = JobSpec { method: Method::Voronoi, anchors, features: Vec::new(), options: MapOptions::default() };
     g.bench_function("armadillo_58k_vs_6k_45_voronoi", |b| {
         b.iter(|| run_map(&spec, &fine, &coarse.mesh, &mut NoProgress).expect("map"))
     });

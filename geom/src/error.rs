@@ -81,6 +81,8 @@ pub enum InputError {
     OutOfRange { what: &'static str, index: usize, count: usize },
     #[error("invalid anchors: {0}")]
     Anchors(String),
+    #[error("invalid feature curves: {0}")]
+    Features(String),
     #[error("invalid job spec: {0}")]
     Spec(String),
     #[error("no consistent patch layout: {0}")]
@@ -110,6 +112,7 @@ impl InputError {
             InputError::NotADisk(_) => "not_a_disk",
             InputError::OutOfRange { .. } => "out_of_range",
             InputError::Anchors(_) => "invalid_anchors",
+            InputError::Features(_) => "invalid_features",
             InputError::Spec(_) => "invalid_spec",
             InputError::LayoutConflict(_) => "layout_conflict",
         }

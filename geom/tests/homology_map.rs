@@ -24,6 +24,7 @@ fn run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, basis: 
 fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, basis: [usize; 2]) -> Option<Run> {
     let spec = JobSpec {
         method: Method::Homology,
+        features: Vec::new(),
         anchors: anchors.iter().map(|&a| [a as u64, gt[a as usize] as u64]).collect(),
         options: MapOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
     };
@@ -146,6 +147,7 @@ fn three_holes_bent_genus_three() {
 fn check_meta(s: &Mesh, t: &Mesh, anchors: &[[u64; 2]], what: &str) {
     let spec = JobSpec {
         method: Method::Homology,
+        features: Vec::new(),
         anchors: anchors.to_vec(),
         options: MapOptions { metric_samples: 2000, meta_mesh: true, ..Default::default() },
     };

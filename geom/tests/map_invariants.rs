@@ -20,6 +20,7 @@ fn check(method: Method, s: &Mesh, t: &Mesh, gt: &[u32], k: usize) -> Checked {
     let spec = JobSpec {
         method,
         anchors: anchors.clone(),
+        features: Vec::new(),
         options: MapOptions { metric_samples: 5000, ..Default::default() },
     };
     let (rep, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();

@@ -2,11 +2,13 @@
 //! patch of both refined meshes is mapped onto one shared canonical triangle ([`patch_param`]),
 //! and a vertex of one mesh is carried to the other by locating its triangle coordinates in the
 //! other mesh's embedding of the same patch ([`compose`], [`locate2d`]). [`smooth`] then lowers
-//! the stretch by relocating vertices inside the common domain.
+//! the stretch by relocating vertices inside the common domain; [`visible`] and [`slide`] fix what
+//! the shared evaluator would count as folded.
 
 pub mod compose;
 pub mod locate2d;
 pub mod patch_param;
+pub mod slide;
 pub mod smooth;
 pub mod visible;
 

@@ -64,7 +64,7 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
 /// Faces of `v`'s star that the evaluator counts as flipped, were `v`'s image at `p` (nearest
 /// target face `pf`) and every other vertex `w` at `pos[w]` (nearest face `near[w]`): normal
 /// against the target's at the faces nearest to all three corners and to the centroid.
-fn evaluator_flips_in_star(
+pub(super) fn evaluator_flips_in_star(
     source: &Mesh,
     tn: &[crate::mesh::V3],
     index: &SurfaceIndex,

@@ -5,11 +5,11 @@
 //! H1 is reported as an integer matrix computed from intersection numbers.
 
 use super::basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis};
+use super::compose::{Planar, locate_all, warp_interior};
 use super::domain::{FundamentalDomainResult, fundamental_domain};
-use crate::crossparam::locate2d::Grid;
 use crate::error::{InputError, Result};
 use crate::map::SurfaceMap;
-use crate::mesh::{FaceId, Mesh, VertexId};
+use crate::mesh::{Mesh, VertexId};
 use crate::param::Uv;
 use serde::{Deserialize, Serialize};
 
@@ -32,6 +32,13 @@ pub struct HomologyMapOptions {
 pub struct SideDomain {
     pub basis: CanonicalBasisResult,
     pub domain: FundamentalDomainResult,
+}
+
+impl SideDomain {
+    /// The disk and its planar positions, for composing maps.
+    pub fn planar(&self) -> Planar<'_> {
+        Planar { disk: &self.basis.disk, uv: &self.domain.uv, refined: Some(&self.basis.refined) }
+    }
 }
 
 /// Maps both ways and what produced them.
@@ -132,80 +139,15 @@ pub fn map_between(
     let shift = if g == 1 { rotation % 4 } else { 4 * (rotation % g) };
     let angle = std::f64::consts::TAU * shift as f64 / m as f64;
     let rot = |p: Uv, a: f64| [p[0] * a.cos() - p[1] * a.sin(), p[0] * a.sin() + p[1] * a.cos()];
-    let warped = warp_to_anchors(&mut s, &t, anchors, &|p| rot(p, -angle))?;
-    let source_to_target = locate_all(source, &s, &t, &|p| rot(p, angle));
-    let target_to_source = locate_all(target, &t, &s, &|p| rot(p, -angle));
+    let warped =
+        warp_interior(&s.basis.disk, &mut s.domain.uv, &s.basis.walk, &t.planar(), anchors, &|p| rot(p, -angle))?;
+    if warped {
+        s.domain.injectivity = super::domain::exact_orientation(&s.basis.disk.mesh, &s.domain.uv);
+    }
+    let source_to_target = locate_all(source.n_vertices(), &s.planar(), &t.planar(), &|p| rot(p, angle));
+    let target_to_source = locate_all(target.n_vertices(), &t.planar(), &s.planar(), &|p| rot(p, -angle));
     let h1 = induced_h1(&s.basis, &t.basis, shift);
     Ok(HomologyMapResult { source_to_target, target_to_source, h1, side_shift: shift, warped, source: s, target: t })
-}
-
-/// Anchors that are interior to both disks, as (source disk vertex, target disk vertex).
-fn interior_copies(s: &SideDomain, t: &SideDomain, anchors: &[(VertexId, VertexId)]) -> Vec<(VertexId, VertexId)> {
-    let copy = |sd: &SideDomain, v: VertexId| -> Option<VertexId> {
-        let d = &sd.basis.disk;
-        let mut it = d.orig.iter().enumerate().filter(|(_, o)| **o == v);
-        let (first, _) = it.next()?;
-        // A vertex with one copy that is not on the boundary lies off every cut loop.
-        let dv = VertexId::from_idx(first);
-        (it.next().is_none() && !d.mesh.is_boundary_vertex(dv)).then_some(dv)
-    };
-    anchors.iter().filter_map(|&(a, b)| Some((copy(s, a)?, copy(t, b)?))).collect()
-}
-
-/// Re-solves the source domain with the anchors (those off the cut loops on both meshes) held
-/// where their partners lie in the target domain (mapped back by `untau`): the constrained
-/// mean-value map. Kept only when it stays bijective; returns whether it was kept.
-fn warp_to_anchors(
-    s: &mut SideDomain,
-    t: &SideDomain,
-    anchors: &[(VertexId, VertexId)],
-    untau: &dyn Fn(Uv) -> Uv,
-) -> Result<bool> {
-    let pairs = interior_copies(s, t, anchors);
-    if pairs.is_empty() {
-        return Ok(false);
-    }
-    let disk = &s.basis.disk.mesh;
-    let mut fixed_uv = s.domain.uv.clone();
-    let mut fixed: Vec<VertexId> = s.basis.walk.clone();
-    for &(a, b) in &pairs {
-        fixed_uv[a.idx()] = untau(t.domain.uv[b.idx()]);
-        fixed.push(a);
-    }
-    let mut sys = crate::linalg::FixedBoundarySystem::new(disk, &fixed)?;
-    sys.prepare_lu()?;
-    let w = crate::linalg::directed_weights(disk, crate::linalg::Weights::MeanValue);
-    let (uv, _) = sys.factor_weights(&w, false)?.solve_with_residual::<2>(&|v| fixed_uv[v.idx()])?;
-    let inj = super::domain::exact_orientation(disk, &uv);
-    if !inj.is_injective() {
-        return Ok(false);
-    }
-    s.domain.uv = uv;
-    s.domain.injectivity = inj;
-    Ok(true)
-}
-
-/// Every original vertex of `from` (through one of its disk copies) located in `to`'s domain.
-fn locate_all(from: &Mesh, fs: &SideDomain, ts: &SideDomain, tau: &dyn Fn(Uv) -> Uv) -> SurfaceMap {
-    let disk = &fs.basis.disk;
-    let mut copy = vec![u32::MAX; from.n_vertices()];
-    for (d, o) in disk.orig.iter().enumerate() {
-        if o.idx() < copy.len() && copy[o.idx()] == u32::MAX {
-            copy[o.idx()] = d as u32;
-        }
-    }
-    let tris = ts.basis.disk.mesh.face_indices();
-    let grid = Grid::new(&ts.domain.uv, &tris);
-    let mut face = Vec::with_capacity(from.n_vertices());
-    let mut bary = Vec::with_capacity(from.n_vertices());
-    for &c in &copy {
-        let p = tau(fs.domain.uv[c as usize]);
-        let (f, b) = grid.locate(&ts.domain.uv, &tris, p);
-        let (of, ob) = ts.basis.refined.to_original(FaceId(f), b);
-        face.push(of);
-        bary.push(ob);
-    }
-    SurfaceMap { face, bary }
 }
 
 /// The induced map on H1 in the two canonical bases: source side `k` lands on target side

@@ -9,12 +9,22 @@
 //! - [`basis`]: the canonical basis itself.
 //! - [`domain`]: the cut disk on the regular 4g-gon.
 //! - [`map`]: maps both ways through the two domains, rotation τ, induced map on H1.
+//! - [`compose`]: two planar disks composed into maps, the interior anchor warp.
 //! - [`overlay`]: the meta-mesh, both tessellations merged.
+//! - [`features`]: feature curves (boundary loops included), the double cover they define.
+//! - [`feature_cut`]: a genus-0 surface cut open so that every feature lies on the boundary.
+//! - [`feature_domain`]: that disk on the unit circle, arcs shared by both meshes.
+//! - [`feature_map`]: maps both ways that take every feature onto its partner.
 
 pub mod basis;
 pub mod cocycle;
+pub mod compose;
 pub mod cut;
 pub mod domain;
+pub mod feature_cut;
+pub mod feature_domain;
+pub mod feature_map;
+pub mod features;
 pub mod map;
 pub mod overlay;
 pub mod refine;

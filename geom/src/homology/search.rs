@@ -45,13 +45,13 @@ fn near_boundary(mesh: &Mesh, except: &[VertexId]) -> Vec<bool> {
 }
 
 /// Shortest-path tree over the vertices `allowed` admits, from `sources`.
-struct Tree {
+pub(super) struct Tree {
     dist: Vec<f64>,
     pred: Vec<u32>,
 }
 
 /// `first` filters the steps out of the sources.
-fn dijkstra(
+pub(super) fn dijkstra(
     mesh: &Mesh,
     sources: &[VertexId],
     allowed: &dyn Fn(VertexId) -> bool,
@@ -95,7 +95,7 @@ fn dijkstra(
     (Tree { dist, pred }, None)
 }
 
-fn path_to(t: &Tree, v: VertexId) -> Vec<VertexId> {
+pub(super) fn path_to(t: &Tree, v: VertexId) -> Vec<VertexId> {
     let mut p = vec![v];
     let mut c = v;
     while t.pred[c.idx()] != u32::MAX {

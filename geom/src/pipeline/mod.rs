@@ -6,6 +6,7 @@ mod artifacts;
 mod job;
 mod remesh_spec;
 mod run;
+mod run_features;
 mod run_homology;
 mod run_quad;
 mod spec;
@@ -16,4 +17,4 @@ pub use remesh_spec::{
 };
 pub use run::{Artifact, MapReport, run_map};
 pub use run_quad::{RemeshReport, Remeshes, remesh_all_for_bench, run_remesh};
-pub use spec::{JobSpec, MAX_ANCHORS, MapOptions, Method};
+pub use spec::{FeatureSpec, JobSpec, MAX_ANCHORS, MAX_FEATURES, MapOptions, Method};

@@ -40,6 +40,9 @@ pub struct MapReport {
     /// `homology` jobs: bases, rotation and the induced map on H1.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub homology: Option<super::run_homology::HomologyReport>,
+    /// `homology` jobs with feature curves or boundaries: the cut and how exactly features map.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub features: Option<super::run_features::FeatureReport>,
 }
 
 pub(super) struct Clock(pub(super) Instant, pub(super) Vec<(String, f64)>);
@@ -77,7 +80,8 @@ pub(super) fn finish_direction(
     let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
     let (mut m, r) = smooth::smooth(from, to, map, fixed, &o.smoothing, progress)?;
     let v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
-    let repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
+    let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
+    repaired += crate::crossparam::slide::slide_boundary(from, to, &mut m, fixed)?;
     smoothed();
     progress.check()?;
     progress.report("metrics", 0.0);
@@ -217,6 +221,7 @@ pub fn run_map(
         timings_ms: Vec::new(),
         smoothing: r1.merge(r2),
         homology: None,
+        features: None,
     };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, &result, &on_target, &on_source)?;
     clock.lap("artifacts");

@@ -4,11 +4,15 @@
 use super::artifacts;
 use super::run::{Artifact, Clock, MapReport, both, finish_direction};
 use super::spec::JobSpec;
+use super::spec::MapOptions;
+use crate::crossparam::smooth::SmoothReport;
 use crate::domain::LayoutStats;
 use crate::error::{Error, Result};
 use crate::homology::{HomologyMapOptions, homology_map, map::SideDomain};
 use crate::io::{self, Format};
+use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, P3, VertexId};
+use crate::metrics::MapMetrics;
 use crate::progress::{NoProgress, Progress};
 use crate::topology::SurfacePoint;
 use serde::Serialize;
@@ -60,6 +64,10 @@ pub fn run_homology(
 ) -> Result<(MapReport, Vec<Artifact>)> {
     let mut clock = Clock(Instant::now(), Vec::new());
     let pairs = spec.validate(source, target)?;
+    let (sc, tc) = spec.curves(source, target)?;
+    if !sc.is_empty() || !crate::topology::boundary_loops(source).is_empty() {
+        return super::run_features::run_features(spec, source, target, &pairs, (&sc, &tc), clock, progress);
+    }
     let o = &spec.options;
     clock.lap("setup");
     progress.report("basis", 0.0);
@@ -67,32 +75,14 @@ pub fn run_homology(
         basis: o.basis,
         rotation: o.rotation,
         max_subdivisions: None,
-        // Reweighting each domain on its own lowers each map's stretch but raised the
-        // composed map's folds on every pair measured (eight/cup, kitten/rocker arm): off.
-        stretch_iterations: 0,
+        // Off by default: reweighting each domain on its own lowers each map's stretch but
+        // raised the composed map's folds on every different-shape pair measured.
+        stretch_iterations: o.domain_stretch_iterations,
     };
     let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
     clock.lap("basis_domain_map");
     progress.check()?;
-    // Anchors beyond the base pair are placed exactly; smoothing then relaxes around them.
-    let (mut s2t, mut t2s) = (r.source_to_target.clone(), r.target_to_source.clone());
-    for &(s, t) in &pairs {
-        let (f, b) = SurfacePoint::Vertex { vertex: t }.in_face(target);
-        s2t.face[s.idx()] = f;
-        s2t.bary[s.idx()] = b;
-        let (f, b) = SurfacePoint::Vertex { vertex: s }.in_face(source);
-        t2s.face[t.idx()] = f;
-        t2s.bary[t.idx()] = b;
-    }
-    let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).collect();
-    let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).collect();
-    let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
-    progress.report("smooth", 0.0);
-    let (a, b) = both(
-        || finish_direction(target, source, t2s, &ta, &rev, o, &mut NoProgress, &mut || {}),
-        || finish_direction(source, target, s2t, &sa, &pairs, o, progress, &mut || {}),
-    )?;
-    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = (a?, b?);
+    let f = finish_pair(source, target, (&r.source_to_target, &r.target_to_source), &pairs, (&[], &[]), o, progress)?;
     clock.lap("smooth_metrics");
     progress.check()?;
     let g = r.source.basis.genus();
@@ -104,7 +94,7 @@ pub fn run_homology(
             .map(|l| l.windows(2).map(|w| (m.position(w[1]) - m.position(w[0])).norm()).sum())
             .collect()
     };
-    let mut arts = artifacts::maps_and_meshes(&s2t, &t2s, &on_target, &on_source);
+    let mut arts = artifacts::maps_and_meshes(&f.s2t, &f.t2s, &f.on_target, &f.on_source);
     let mut meta = None;
     if o.meta_mesh {
         progress.report("meta_mesh", 0.0);
@@ -154,24 +144,80 @@ pub fn run_homology(
         source_vertices: source.n_vertices(),
         target_vertices: target.n_vertices(),
         layout: LayoutStats::default(),
-        source_to_target: m1,
-        target_to_source: m2,
+        source_to_target: f.m1,
+        target_to_source: f.m2,
         timings_ms: Vec::new(),
-        smoothing: r1.merge(r2),
+        smoothing: f.smoothing,
         homology: Some(report),
+        features: None,
     };
+    finish_report(&mut report, clock, &mut arts)?;
+    progress.report("done", 1.0);
+    Ok((report, arts))
+}
+
+/// Both directions after the domain maps, and what they measured.
+pub(super) struct FinishedPair {
+    pub s2t: SurfaceMap,
+    pub t2s: SurfaceMap,
+    pub on_target: Mesh,
+    pub on_source: Mesh,
+    pub m1: MapMetrics,
+    pub m2: MapMetrics,
+    pub smoothing: SmoothReport,
+}
+
+/// Places the anchors exactly, then smooths both directions (anchors and `fixed` held: source
+/// vertices, target vertices), makes them visible, repairs folds and measures.
+///
+/// # Errors
+/// As [`finish_direction`].
+pub(super) fn finish_pair(
+    source: &Mesh,
+    target: &Mesh,
+    maps: (&SurfaceMap, &SurfaceMap),
+    pairs: &[(VertexId, VertexId)],
+    fixed: (&[VertexId], &[VertexId]),
+    o: &MapOptions,
+    progress: &mut dyn Progress,
+) -> Result<FinishedPair> {
+    let (mut s2t, mut t2s) = (maps.0.clone(), maps.1.clone());
+    for &(s, t) in pairs {
+        let (f, b) = SurfacePoint::Vertex { vertex: t }.in_face(target);
+        s2t.face[s.idx()] = f;
+        s2t.bary[s.idx()] = b;
+        let (f, b) = SurfacePoint::Vertex { vertex: s }.in_face(source);
+        t2s.face[t.idx()] = f;
+        t2s.bary[t.idx()] = b;
+    }
+    let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).chain(fixed.0.iter().copied()).collect();
+    let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).chain(fixed.1.iter().copied()).collect();
+    let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
+    progress.report("smooth", 0.0);
+    let (a, b) = both(
+        || finish_direction(target, source, t2s, &ta, &rev, o, &mut NoProgress, &mut || {}),
+        || finish_direction(source, target, s2t, &sa, pairs, o, progress, &mut || {}),
+    )?;
+    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = (a?, b?);
+    Ok(FinishedPair { s2t, t2s, on_target, on_source, m1, m2, smoothing: r1.merge(r2) })
+}
+
+/// Adds the total to the timings and writes `metrics.json`.
+///
+/// # Errors
+/// `Internal` if the report does not serialize.
+pub(super) fn finish_report(report: &mut MapReport, mut clock: Clock, arts: &mut Vec<Artifact>) -> Result<()> {
     let total: f64 = clock.1.iter().map(|x| x.1).sum();
     clock.1.push(("total".into(), total));
     report.timings_ms = clock.1;
     arts.push(json_artifact(
         "metrics.json",
-        &serde_json::to_value(&report).map_err(|e| Error::Internal(e.to_string()))?,
+        &serde_json::to_value(&*report).map_err(|e| Error::Internal(e.to_string()))?,
     )?);
-    progress.report("done", 1.0);
-    Ok((report, arts))
+    Ok(())
 }
 
-fn json_artifact(name: &str, v: &serde_json::Value) -> Result<Artifact> {
+pub(super) fn json_artifact(name: &str, v: &serde_json::Value) -> Result<Artifact> {
     let bytes = serde_json::to_vec_pretty(v).map_err(|e| Error::Internal(e.to_string()))?;
     Ok(Artifact { name: name.into(), content_type: "application/json", bytes })
 }

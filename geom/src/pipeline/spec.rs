@@ -5,6 +5,7 @@ use crate::crossparam::PatchParamOptions;
 use crate::crossparam::smooth::SmoothOptions;
 use crate::domain::LayoutOptions;
 use crate::error::{InputError, Result};
+use crate::homology::features::{Curve, check_disjoint, validate_curve};
 use crate::mesh::{Mesh, VertexId};
 use crate::topology;
 use serde::{Deserialize, Serialize};
@@ -49,6 +50,10 @@ pub struct MapOptions {
     pub rotation: usize,
     /// `homology`: also merge both tessellations into the meta-mesh pair.
     pub meta_mesh: bool,
+    /// `homology`: Yoshizawa–Belyaev–Seidel stretch-minimizing reweighting rounds of each
+    /// planar domain (0 = the plain mean-value map). Spreads protrusions that the harmonic map
+    /// crushes (a hand cut at the wrist) at the price of more folds between different shapes.
+    pub domain_stretch_iterations: usize,
 }
 
 impl Default for MapOptions {
@@ -61,22 +66,37 @@ impl Default for MapOptions {
             basis: [0, 0],
             rotation: 0,
             meta_mesh: false,
+            domain_stretch_iterations: 0,
         }
     }
 }
 
-/// `{"method": ..., "anchors": [[s, t], ...], "options": {...}}`.
+/// One pair of corresponding feature curves: vertex paths on the source and on the target. A
+/// closed list (last = first) is a whole boundary loop.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FeatureSpec {
+    pub source: Vec<u64>,
+    pub target: Vec<u64>,
+}
+
+/// `{"method": ..., "anchors": [[s, t], ...], "features": [...], "options": {...}}`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct JobSpec {
     pub method: Method,
     pub anchors: Vec<[u64; 2]>,
+    /// `homology`: corresponding feature curves, mapped exactly.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub features: Vec<FeatureSpec>,
     #[serde(default)]
     pub options: MapOptions,
 }
 
 /// Most anchors a job may have.
 pub const MAX_ANCHORS: usize = 4096;
+/// Most feature curves a job may have.
+pub const MAX_FEATURES: usize = 256;
 
 impl JobSpec {
     /// Parses a spec from JSON.
@@ -102,7 +122,7 @@ impl JobSpec {
         let anchors = match a {
             A::Obj { anchors } | A::List(anchors) => anchors,
         };
-        Ok(JobSpec { method, anchors, options: MapOptions::default() })
+        Ok(JobSpec { method, anchors, features: Vec::new(), options: MapOptions::default() })
     }
 
     /// Checks the spec against the meshes: same genus, closed surfaces, anchors in range and
@@ -112,6 +132,23 @@ impl JobSpec {
     /// `InputError::TopologyMismatch`, `InputError::Anchors`.
     pub fn validate(&self, source: &Mesh, target: &Mesh) -> Result<Vec<(VertexId, VertexId)>> {
         self.check(&topology::summary(source), &topology::summary(target))
+    }
+
+    /// The feature curves, checked against both meshes: vertex paths along edges, simple,
+    /// pairwise disjoint, open ones off the boundary, closed ones whole boundary loops.
+    ///
+    /// # Errors
+    /// `InputError::Features` naming the curve and the fault.
+    pub fn curves(&self, source: &Mesh, target: &Mesh) -> Result<(Vec<Curve>, Vec<Curve>)> {
+        let mut s = Vec::with_capacity(self.features.len());
+        let mut t = Vec::with_capacity(self.features.len());
+        for (i, f) in self.features.iter().enumerate() {
+            s.push(validate_curve(source, &f.source, &format!("feature {i} (source)"))?);
+            t.push(validate_curve(target, &f.target, &format!("feature {i} (target)"))?);
+        }
+        check_disjoint(&s, source.n_vertices(), "source")?;
+        check_disjoint(&t, target.n_vertices(), "target")?;
+        Ok((s, t))
     }
 
     /// [`JobSpec::validate`] from the meshes' summaries alone, so a server can answer before
@@ -134,7 +171,29 @@ impl JobSpec {
             ))
             .into());
         }
-        if ss.boundary_loops != 0 || ts.boundary_loops != 0 {
+        if ss.boundary_loops != ts.boundary_loops {
+            return Err(InputError::TopologyMismatch(format!(
+                "boundary mismatch: source has {} boundary loops, target {}",
+                ss.boundary_loops, ts.boundary_loops
+            ))
+            .into());
+        }
+        let curves = self.features.len() + ss.boundary_loops;
+        if self.method != Method::Homology && !self.features.is_empty() {
+            return Err(InputError::Features(format!(
+                "method {} takes no feature curves (method homology does)",
+                self.method.name()
+            ))
+            .into());
+        }
+        if curves > 0 && ss.genus > 0 {
+            return Err(InputError::TopologyMismatch(format!(
+                "feature curves and boundary loops are supported on genus-0 surfaces; these have genus {}",
+                ss.genus
+            ))
+            .into());
+        }
+        if ss.boundary_loops != 0 && self.method != Method::Homology {
             return Err(InputError::TopologyMismatch(format!(
                 "method {} maps closed surfaces; source has {} boundary loops, target {}",
                 self.method.name(),
@@ -144,16 +203,26 @@ impl JobSpec {
             .into());
         }
         let n = self.anchors.len();
+        if self.features.len() > MAX_FEATURES {
+            return Err(InputError::Features(format!(
+                "{} feature curves exceed the limit {MAX_FEATURES}",
+                self.features.len()
+            ))
+            .into());
+        }
         if n > MAX_ANCHORS {
             return Err(InputError::Anchors(format!("{n} anchors exceed the limit {MAX_ANCHORS}")).into());
         }
         let need = match (self.method, ss.genus) {
-            (Method::Homology, 0) => {
+            (Method::Homology, 0) if curves == 0 => {
                 return Err(InputError::TopologyMismatch(
-                    "method homology needs genus >= 1 (feature curves that would add handles to a genus-0 surface are not supported yet)".into(),
+                    "method homology on a closed genus-0 surface needs feature curves: each becomes a handle".into(),
                 )
                 .into());
             }
+            // A disk without features: the anchor fixes where its boundary starts.
+            (Method::Homology, 0) if self.features.is_empty() => 1,
+            (Method::Homology, 0) => 0,
             // The base vertex of both canonical bases.
             (Method::Homology, _) => 1,
             (_, 0) => 3,

@@ -1,0 +1,95 @@
+//! The planar domain of a feature cut: the disk mapped onto the unit circle with mean-value
+//! weights (Floater 2003), side `k` on the arc `[θ_k, θ_{k+1}]` by arc length. Both meshes of a
+//! pair use the same arcs, so the two domains share their boundary and their composition is a
+//! bijection that takes every feature onto its partner.
+//!
+//! A circle instead of the paper's regular polygon: the boundary vertices are then in strictly
+//! convex position, so Floater's theorem holds even where an edge joins two boundary vertices
+//! (a link that runs beside a feature), and no corner ever carries a degenerate triangle. Arcs
+//! are sized by each side's share of its boundary's length, averaged over the two meshes.
+
+use super::domain::exact_orientation;
+use super::feature_cut::FeatureCutResult;
+use crate::error::{Error, Result};
+use crate::linalg::{FixedBoundarySystem, Weights, directed_weights};
+use crate::param::{InjectivityReport, StretchOptions, Uv, minimize_stretch};
+
+/// One mesh's disk on the circle.
+#[derive(Debug, Clone)]
+pub struct FeatureDomainResult {
+    /// Per vertex of the cut disk.
+    pub uv: Vec<Uv>,
+    /// Angle where each side starts; side `k` ends where `k + 1` starts (the last at 2π).
+    pub angles: Vec<f64>,
+    pub injectivity: InjectivityReport,
+    /// Relative residual of the solve.
+    pub residual: f64,
+}
+
+/// Arc per side (summing to 1): each side's share of its boundary length, averaged over the
+/// two cuts.
+///
+/// # Errors
+/// `Internal` when the cuts' boundary words differ (they are built to agree).
+pub fn shared_arcs(a: &FeatureCutResult, b: &FeatureCutResult) -> Result<Vec<f64>> {
+    let kinds = |c: &FeatureCutResult| c.sides.iter().map(|s| s.kind).collect::<Vec<_>>();
+    if kinds(a) != kinds(b) {
+        return Err(Error::Internal(format!("feature cuts disagree: {:?} against {:?}", kinds(a), kinds(b))));
+    }
+    let share = |c: &FeatureCutResult| {
+        let t: f64 = c.sides.iter().map(|s| s.length).sum();
+        c.sides.iter().map(|s| s.length / t).collect::<Vec<f64>>()
+    };
+    let (sa, sb) = (share(a), share(b));
+    Ok(sa.iter().zip(&sb).map(|(x, y)| 0.5 * (x + y)).collect())
+}
+
+/// Maps the cut disk onto the unit circle with the given arcs.
+///
+/// # Errors
+/// `Numerical` when the solve fails or the map folds.
+pub fn feature_domain(cut: &FeatureCutResult, arcs: &[f64], stretch_iterations: usize) -> Result<FeatureDomainResult> {
+    let disk = &cut.disk.mesh;
+    let walk = &cut.walk;
+    if arcs.len() != cut.sides.len() {
+        return Err(Error::Internal(format!("{} arcs for {} sides", arcs.len(), cut.sides.len())));
+    }
+    let tau = std::f64::consts::TAU;
+    let mut angles = Vec::with_capacity(arcs.len());
+    let mut acc = 0.0;
+    for a in arcs {
+        angles.push(tau * acc);
+        acc += a;
+    }
+    let mut fixed = vec![[f64::NAN; 2]; disk.n_vertices()];
+    for (k, s) in cut.sides.iter().enumerate() {
+        let end = if k + 1 < angles.len() { angles[k + 1] } else { tau };
+        let mut t = 0.0;
+        for i in 0..s.edges {
+            let (v, w) = (walk[(s.start + i) % walk.len()], walk[(s.start + i + 1) % walk.len()]);
+            let th = angles[k] + (end - angles[k]) * t / s.length.max(f64::MIN_POSITIVE);
+            fixed[v.idx()] = [th.cos(), th.sin()];
+            t += (disk.position(w) - disk.position(v)).norm();
+        }
+    }
+    let mut sys = FixedBoundarySystem::new(disk, walk)?;
+    sys.prepare_lu()?;
+    let w = directed_weights(disk, Weights::MeanValue);
+    let (uv, residual) = sys.factor_weights(&w, false)?.solve_with_residual::<2>(&|v| fixed[v.idx()])?;
+    let (uv, residual) = if stretch_iterations > 0 {
+        let so = StretchOptions { iterations: stretch_iterations, ..Default::default() };
+        let r = minimize_stretch(disk, &sys, &w, uv, &|v| fixed[v.idx()], &so)?;
+        let res = if r.rounds > 0 { r.residual } else { residual };
+        (r.uv, res)
+    } else {
+        (uv, residual)
+    };
+    let injectivity = exact_orientation(disk, &uv);
+    if !injectivity.is_injective() {
+        return Err(Error::Numerical(format!(
+            "feature domain: {} flipped and {} degenerate triangles",
+            injectivity.flipped, injectivity.degenerate
+        )));
+    }
+    Ok(FeatureDomainResult { uv, angles, injectivity, residual })
+}

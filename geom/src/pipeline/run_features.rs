@@ -1,0 +1,160 @@
+//! `run_features`: a `homology` job whose surfaces carry feature curves or boundary loops
+//! (genus 0): feature cut -> circle domains -> maps both ways -> anchor snapping -> smoothing
+//! with every feature vertex held -> metrics (with the feature error) -> artifacts.
+
+use super::artifacts;
+use super::run::{Artifact, Clock, MapReport};
+use super::run_homology::{finish_pair, finish_report, json_artifact};
+use super::spec::JobSpec;
+use crate::domain::LayoutStats;
+use crate::error::Result;
+use crate::homology::feature_cut::{FeatureCutResult, Side, SideKind};
+use crate::homology::feature_map::{FeatureSide, feature_error, feature_map};
+use crate::homology::features::{Curve, CurveKind};
+use crate::io::{self, Format};
+use crate::mesh::{Mesh, P3, VertexId};
+use crate::progress::Progress;
+use serde::Serialize;
+use serde_json::json;
+
+/// What a feature job adds to `metrics.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct FeatureReport {
+    /// Curves mapped (given features, then an unlisted boundary loop).
+    pub curves: usize,
+    /// Chain order: `[given feature index, entered at its last vertex]`; `F1, F2, …` in the
+    /// word and in `basis_*.json` follow it.
+    pub order: Vec<(usize, bool)>,
+    pub kinds: Vec<CurveKind>,
+    /// Genus of the double cover the curves define (`2g + n − 1`).
+    pub doubled_genus: usize,
+    /// The cut disk's boundary word, e.g. `F1 L1 F2 F2^-1 L1^-1 F1^-1`.
+    pub word: String,
+    /// Largest distance of a mapped feature vertex from its partner curve, relative to the
+    /// bounding-box diagonal: source→target, target→source.
+    pub feature_error: [f64; 2],
+    /// Whether the source domain was warped onto interior anchors.
+    pub anchor_warp: bool,
+    /// Flipped triangles in the two planar domains (0: both maps bijective).
+    pub domain_flips: [usize; 2],
+}
+
+/// Runs a feature job (called by `run_homology` when the spec has features or the meshes have
+/// boundary loops).
+///
+/// # Errors
+/// As [`super::run_map`].
+pub(super) fn run_features(
+    spec: &JobSpec,
+    source: &Mesh,
+    target: &Mesh,
+    pairs: &[(VertexId, VertexId)],
+    curves: (&[Curve], &[Curve]),
+    mut clock: Clock,
+    progress: &mut dyn Progress,
+) -> Result<(MapReport, Vec<Artifact>)> {
+    let o = &spec.options;
+    clock.lap("setup");
+    progress.report("feature_cut", 0.0);
+    let r = feature_map(source, target, curves.0, curves.1, pairs, o.domain_stretch_iterations)?;
+    clock.lap("cut_domain_map");
+    progress.check()?;
+    // Open curves and the chain's junctions stay put; boundary vertices between junctions may
+    // slide along the partner boundary (they stay on it).
+    let held = |c: &FeatureCutResult| -> Vec<VertexId> {
+        let open = c.curves.iter().filter(|c| c.kind == CurveKind::Open).flat_map(|c| c.vertices.iter().copied());
+        let ends = c.links.iter().flat_map(|l| [l[0], l[l.len() - 1]]);
+        let starts = c.curves.iter().map(|c| c.vertices[0]);
+        open.chain(ends).chain(starts).collect()
+    };
+    let (hs, ht) = (held(&r.source.cut), held(&r.target.cut));
+    let f = finish_pair(source, target, (&r.source_to_target, &r.target_to_source), pairs, (&hs, &ht), o, progress)?;
+    clock.lap("smooth_metrics");
+    progress.check()?;
+    let (sc, tc) = (&r.source.cut.curves, &r.target.cut.curves);
+    let report = FeatureReport {
+        curves: sc.len(),
+        order: r.order.clone(),
+        kinds: sc.iter().map(|c| c.kind).collect(),
+        doubled_genus: r.source.cut.doubled_genus,
+        word: word(&r.source.cut),
+        feature_error: [feature_error(&f.s2t, target, sc, tc), feature_error(&f.t2s, source, tc, sc)],
+        anchor_warp: r.warped,
+        domain_flips: [r.source.domain.injectivity.flipped, r.target.domain.injectivity.flipped],
+    };
+    let mut arts = artifacts::maps_and_meshes(&f.s2t, &f.t2s, &f.on_target, &f.on_source);
+    arts.push(json_artifact("basis_source.json", &cut_json(&r.source, source))?);
+    arts.push(json_artifact("basis_target.json", &cut_json(&r.target, target))?);
+    arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });
+    arts.push(Artifact { name: "domain_target.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.target)? });
+    clock.lap("artifacts");
+    let mut report = MapReport {
+        method: spec.method.name(),
+        anchors: pairs.len(),
+        patches: 1,
+        source_vertices: source.n_vertices(),
+        target_vertices: target.n_vertices(),
+        layout: LayoutStats::default(),
+        source_to_target: f.m1,
+        target_to_source: f.m2,
+        timings_ms: Vec::new(),
+        smoothing: f.smoothing,
+        homology: None,
+        features: Some(report),
+    };
+    finish_report(&mut report, clock, &mut arts)?;
+    progress.report("done", 1.0);
+    Ok((report, arts))
+}
+
+/// The boundary word: `F` for an open curve, `B` for a boundary arc, `L` for a link, `^-1`
+/// when a slit side comes back.
+fn word(c: &FeatureCutResult) -> String {
+    let mut seen = std::collections::HashSet::new();
+    c.sides
+        .iter()
+        .map(|s: &Side| {
+            let (letter, i) = match s.kind {
+                SideKind::Curve(i) if c.curves[i].kind == CurveKind::Boundary => ('B', i),
+                SideKind::Curve(i) => ('F', i),
+                SideKind::Link(i) => ('L', i),
+            };
+            let inv = if seen.insert(s.kind) || letter == 'B' { "" } else { "^-1" };
+            format!("{letter}{}{inv}", i + 1)
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Curves and links as 3D polylines, the sides, and the double cover's genus.
+fn cut_json(fs: &FeatureSide, mesh: &Mesh) -> serde_json::Value {
+    let c = &fs.cut;
+    let poly =
+        |v: &[VertexId]| -> Vec<[f64; 3]> { v.iter().map(|&x| mesh.position(x)).map(|p| [p.x, p.y, p.z]).collect() };
+    let curves: Vec<_> = c
+        .curves
+        .iter()
+        .enumerate()
+        .map(|(i, cv)| json!({"name": format!("F{}", i + 1), "kind": cv.kind, "vertices": cv.vertices.iter().map(|v| v.0).collect::<Vec<_>>(), "points": poly(&cv.vertices)}))
+        .collect();
+    let links: Vec<_> =
+        c.links.iter().enumerate().map(|(i, l)| json!({"name": format!("L{}", i + 1), "points": poly(l)})).collect();
+    json!({
+        "genus": 0,
+        "doubled_genus": c.doubled_genus,
+        "base_vertex": c.base.0,
+        "curves": curves,
+        "links": links,
+        "sides": c.sides,
+        "arc_start_angles": fs.domain.angles,
+        "word": word(c),
+        "disk_euler_characteristic": crate::topology::euler_characteristic(&c.disk.mesh),
+    })
+}
+
+/// The planar disk as a mesh at z = 0.
+fn domain_obj(fs: &FeatureSide) -> Result<Vec<u8>> {
+    let pos: Vec<P3> = fs.domain.uv.iter().map(|p| P3::new(p[0], p[1], 0.0)).collect();
+    let m = Mesh::from_triangles(pos, &fs.cut.disk.mesh.face_indices())?;
+    Ok(io::write(&m, Format::Obj))
+}

@@ -1,0 +1,156 @@
+//! Method `homology` with feature curves and boundary loops (Carner et al. section 3.4) on
+//! shared meshes: genus-0 surfaces, closed and with a boundary loop, four features each. Every
+//! feature vertex lands on its partner curve, nothing folds, both outputs keep the input faces,
+//! and bad curves are refused with a typed error.
+
+use geom::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
+use geom::io::ReadOptions;
+use geom::mesh::{Mesh, VertexId};
+use geom::pipeline::{FeatureSpec, JobSpec, MapOptions, MapReport, Method, run_map};
+use geom::progress::NoProgress;
+use geom::topology::Locator;
+
+mod common;
+use common::{bent, load, twisted};
+
+/// `k` feature curves: centres spread by farthest-point sampling over vertices two rings away
+/// from the boundary and from earlier curves, each a shortest path of about 6% of the diagonal
+/// towards +x.
+fn features(m: &Mesh, k: usize) -> Vec<Vec<VertexId>> {
+    let n = m.n_vertices();
+    let mut blocked: Vec<bool> = (0..n).map(|v| m.is_boundary_vertex(VertexId::from_idx(v))).collect();
+    let grow = |b: &mut Vec<bool>, times: usize| {
+        for _ in 0..times {
+            let cur = b.clone();
+            for (v, _) in cur.iter().enumerate().filter(|x| *x.1) {
+                for w in m.vertex_neighbors(VertexId::from_idx(v)) {
+                    b[w.idx()] = true;
+                }
+            }
+        }
+    };
+    grow(&mut blocked, 2);
+    let r = 0.06 * m.bbox_diagonal();
+    let mut centres: Vec<VertexId> = Vec::new();
+    let mut out = Vec::new();
+    for _ in 0..k {
+        let free = (0..n).map(VertexId::from_idx).filter(|v| !blocked[v.idx()]);
+        let c = free
+            .max_by(|&a, &b| {
+                let d =
+                    |v: VertexId| centres.iter().map(|&c| (m.position(v) - m.position(c)).norm()).fold(1e300, f64::min);
+                d(a).total_cmp(&d(b))
+            })
+            .expect("room for a curve");
+        let o = VertexDijkstraOptions { blocked: Some(&blocked), max_distance: Some(r), ..Default::default() };
+        let d = vertex_dijkstra(m, &[(c, 0.0)], &o).unwrap();
+        let end = (0..n)
+            .map(VertexId::from_idx)
+            .filter(|v| d.dist[v.idx()] > 0.6 * r && d.dist[v.idx()] <= r)
+            .max_by(|a, b| m.position(*a).x.total_cmp(&m.position(*b).x))
+            .expect("an end");
+        let p = d.path_to(end).unwrap();
+        let mut ring = vec![false; n];
+        for v in &p {
+            ring[v.idx()] = true;
+        }
+        grow(&mut ring, 2);
+        for (b, r) in blocked.iter_mut().zip(&ring) {
+            *b |= r;
+        }
+        centres.push(c);
+        out.push(p);
+    }
+    out
+}
+
+fn spec(curves: &[Vec<VertexId>], anchors: Vec<[u64; 2]>) -> JobSpec {
+    let raw = |p: &Vec<VertexId>| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
+    JobSpec {
+        method: Method::Homology,
+        anchors,
+        features: curves.iter().map(|p| FeatureSpec { source: raw(p), target: raw(p) }).collect(),
+        options: MapOptions { metric_samples: 5000, ..Default::default() },
+    }
+}
+
+/// Runs a job on a same-shape pair (vertex `i` ↔ vertex `i`) and checks what every feature job
+/// must satisfy; returns the report and the mean ground-truth error over √area.
+fn check(s: &Mesh, t: &Mesh, sp: &JobSpec) -> (MapReport, f64) {
+    let (report, arts) = run_map(sp, s, t, &mut NoProgress).unwrap();
+    for n in ["basis_source.json", "basis_target.json", "domain_source.obj", "domain_target.obj", "metrics.json"] {
+        assert!(arts.iter().any(|a| a.name == n), "missing {n}");
+    }
+    let f = report.features.as_ref().expect("a feature report");
+    assert!(
+        f.feature_error[0] <= 1e-9 && f.feature_error[1] <= 1e-9,
+        "features off their partners: {:?}",
+        f.feature_error
+    );
+    assert_eq!(f.domain_flips, [0, 0]);
+    assert_eq!(f.doubled_genus, f.curves - 1);
+    assert_eq!((report.source_to_target.flipped_faces, report.target_to_source.flipped_faces), (0, 0));
+    let obj = arts.iter().find(|a| a.name == "source_on_target.obj").unwrap();
+    let mapped = geom::io::read(&obj.bytes, &ReadOptions::default()).unwrap().mesh;
+    assert_eq!(mapped.faces(), s.faces(), "equal connectivity");
+    let loc = Locator::new(t).unwrap();
+    let off = mapped.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
+    assert!(off <= 1e-9 * t.bbox_diagonal(), "off surface {off}");
+    let gt =
+        mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(i as u32))).norm()).sum::<f64>()
+            / mapped.n_vertices() as f64
+            / t.area().sqrt();
+    (report, gt)
+}
+
+#[test]
+fn a_hand_with_four_features_and_its_wrist_maps_onto_a_bent_copy() {
+    let s = load("hand_lowres.obj");
+    let t = bent(&s);
+    let c = features(&s, 4);
+    let (r, gt) = check(&s, &t, &spec(&c, vec![]));
+    let f = r.features.unwrap();
+    assert_eq!(f.curves, 5, "four features and the wrist");
+    assert!(f.word.contains("B5"), "{}", f.word);
+    assert!(gt < 0.1, "gt {gt}");
+}
+
+#[test]
+fn a_closed_bunny_with_three_features_maps_onto_a_twisted_copy() {
+    let s = load("bunny.off");
+    let t = twisted(&s);
+    let c = features(&s, 3);
+    let (r, gt) = check(&s, &t, &spec(&c, vec![]));
+    assert_eq!(r.features.unwrap().doubled_genus, 2);
+    assert!(gt < 0.1, "gt {gt}");
+}
+
+#[test]
+fn a_face_maps_onto_itself_exactly() {
+    let s = load("face.off");
+    let c = features(&s, 4);
+    let (_, gt) = check(&s, &s, &spec(&c, vec![]));
+    assert!(gt < 1e-9, "gt {gt}");
+}
+
+#[test]
+fn bad_curves_and_unsupported_topologies_are_refused() {
+    let s = load("face.off");
+    let b = (0..s.n_vertices() as u32).find(|&v| s.is_boundary_vertex(VertexId(v))).unwrap();
+    let nb = s.vertex_neighbors(VertexId(b)).find(|w| !s.is_boundary_vertex(*w)).unwrap();
+    let touching = vec![vec![VertexId(b), nb]];
+    let e = run_map(&spec(&touching, vec![]), &s, &s, &mut NoProgress).unwrap_err();
+    assert_eq!(e.code(), "invalid_features", "{e}");
+    let e = run_map(&spec(&[], vec![]), &s, &s, &mut NoProgress).unwrap_err();
+    assert_eq!(e.code(), "invalid_anchors", "{e}");
+    let h = load("eight.hole.off");
+    let e = run_map(&spec(&[], vec![[0, 0]]), &h, &h, &mut NoProgress).unwrap_err();
+    assert_eq!(e.code(), "topology_mismatch", "{e}");
+    let closed = load("bunny.off");
+    let e = run_map(&spec(&[], vec![[0, 0]]), &closed, &closed, &mut NoProgress).unwrap_err();
+    assert_eq!(e.code(), "topology_mismatch", "{e}");
+    let mut sp = spec(&features(&closed, 1), vec![]);
+    sp.method = Method::Voronoi;
+    let e = run_map(&sp, &closed, &closed, &mut NoProgress).unwrap_err();
+    assert_eq!(e.code(), "invalid_features", "{e}");
+}

@@ -133,16 +133,23 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
             // Loops that pen a corner in leave no vertex between them: split every edge at
             // their vertices (a band of new vertices along each loop); a crowded base vertex
             // gets twice its edges; chords joining loop vertices are split. Then search again.
-            let split = match extra {
-                0 | 1 | 4 => band_of(&local.mesh, &partial, base),
-                3 => chords_of(&local.mesh, &partial),
-                _ => Vec::new(),
-            };
-            if extra == 2 {
-                let valence = local.mesh.outgoing(base).count();
-                local = local.raise_valence(base, 2 * valence)?;
-            } else if !split.is_empty() {
-                local = local.split_edges(&split)?;
+            // The second failure takes the whole remedy at once (the loops found so far are
+            // threaded through each step); later ones take one step each.
+            let mut partial = partial;
+            for &step in REFINE_STEPS[extra.min(REFINE_STEPS.len() - 1)] {
+                let before = local.mesh.clone();
+                local = match step {
+                    Step::Band => local.split_edges(&band_of(&local.mesh, &partial, base))?,
+                    Step::Chords => local.split_edges(&chords_of(&local.mesh, &partial))?,
+                    Step::Valence => {
+                        let valence = local.mesh.outgoing(base).count();
+                        local.raise_valence(base, 2 * valence)?
+                    }
+                };
+                match rethread(&before, &local.mesh, &partial) {
+                    Some(p) => partial = p,
+                    None => break,
+                }
             }
         }
         if round < opts.max_subdivisions {
@@ -160,6 +167,27 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
 
 /// Searches per subdivision round (each failed one refines before the next).
 const ATTEMPTS_PER_ROUND: usize = 6;
+
+/// One local refinement around the loops found by a stuck search.
+#[derive(Debug, Clone, Copy)]
+enum Step {
+    /// Split every edge at a loop vertex (the base's own edges excepted).
+    Band,
+    /// Double the base vertex's valence.
+    Valence,
+    /// Split edges that join two loop vertices without being on a loop.
+    Chords,
+}
+
+/// What each failed search of a round applies before the next.
+const REFINE_STEPS: [&[Step]; 6] = [
+    &[Step::Band],
+    &[Step::Band, Step::Valence, Step::Chords, Step::Band],
+    &[Step::Band],
+    &[Step::Valence],
+    &[Step::Chords],
+    &[Step::Band],
+];
 
 /// Handle by handle on the surface cut so far; `None` when loops would have to touch.
 /// Each handle tries the corners between commutators (most reachable interior first) and, at
@@ -213,6 +241,28 @@ fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<std::re
 }
 
 type Loops = Vec<Vec<VertexId>>;
+
+/// `loops` (vertex lists of `before`) on `after`, a refinement that split some of their edges at
+/// midpoints: each split step goes through its midpoint. `None` when a step cannot be followed.
+fn rethread(before: &Mesh, after: &Mesh, loops: &[Vec<VertexId>]) -> Option<Loops> {
+    loops
+        .iter()
+        .map(|l| {
+            let mut out = vec![*l.first()?];
+            for w in l.windows(2) {
+                if super::cut::edge_between(after, w[0], w[1]).is_none() {
+                    let mid = nalgebra::center(&before.position(w[0]), &before.position(w[1]));
+                    let m = after
+                        .vertex_neighbors(w[0])
+                        .find(|&m| after.position(m) == mid && super::cut::edge_between(after, m, w[1]).is_some())?;
+                    out.push(m);
+                }
+                out.push(w[1]);
+            }
+            Some(out)
+        })
+        .collect()
+}
 
 /// Edges at the loops' vertices (the base vertex's own edges excepted).
 fn band_of(mesh: &Mesh, loops: &[Vec<VertexId>], base: VertexId) -> Vec<[VertexId; 2]> {

@@ -7,6 +7,7 @@
 //! [`Mesh::from_raw`] refuses or repairs (with a warning) anything else.
 
 mod build;
+mod cut_copy;
 mod ids;
 pub mod shapes;
 mod triangulate;

@@ -143,37 +143,50 @@ fn three_holes_bent_genus_three() {
     assert!(others.iter().all(|o| *o != h.h1) && others[0] != others[1]);
 }
 
-/// The meta-mesh pair: one face list, every vertex on its own surface, the surfaces' topology.
-fn check_meta(s: &Mesh, t: &Mesh, anchors: &[[u64; 2]], what: &str) {
+/// The meta-mesh pair (pruned below `prune` degrees if given): one face list, every vertex on
+/// its own surface, the surfaces' topology. Returns the face count.
+fn check_meta(s: &Mesh, t: &Mesh, anchors: &[[u64; 2]], what: &str, prune: Option<f64>) -> usize {
     let spec = JobSpec {
         method: Method::Homology,
         features: Vec::new(),
         anchors: anchors.to_vec(),
-        options: MapOptions { metric_samples: 2000, meta_mesh: true, ..Default::default() },
+        options: MapOptions {
+            metric_samples: 2000,
+            meta_mesh: true,
+            dihedral_threshold_deg: prune,
+            ..Default::default()
+        },
     };
     let (report, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();
     let stats = report.homology.as_ref().unwrap().meta_mesh.clone().unwrap();
     assert!(stats.error.is_none(), "{what}: {stats:?}");
+    assert_eq!(stats.pruned_vertices.is_some(), prune.is_some());
     let get = |n: &str| {
         let a = arts.iter().find(|a| a.name == n).unwrap_or_else(|| panic!("{what}: missing {n}"));
         geom::io::read(&a.bytes, &ReadOptions::default()).unwrap().mesh
     };
     let (ms, mt) = (get("meta_source.obj"), get("meta_target.obj"));
     assert_eq!(ms.faces(), mt.faces(), "{what}: shared faces");
-    assert!(ms.n_vertices() >= s.n_vertices().max(t.n_vertices()), "{what}: {} meta vertices", ms.n_vertices());
+    if prune.is_none() {
+        assert!(ms.n_vertices() >= s.n_vertices().max(t.n_vertices()), "{what}: {} meta vertices", ms.n_vertices());
+    }
     assert_eq!(geom::topology::euler_characteristic(&ms), geom::topology::euler_characteristic(s), "{what}: χ");
     for (m, surf) in [(&ms, s), (&mt, t)] {
         let loc = Locator::new(surf).unwrap();
         let off = m.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
         assert!(off <= 1e-9 * surf.bbox_diagonal(), "{what}: off surface {off}");
     }
+    ms.n_faces()
 }
 
 #[test]
 fn meta_mesh_kitten_bent_and_torus_pair() {
     let s = load("kitten.nf20k.off");
-    check_meta(&s, &bent(&s), &[[0, 0]], "kitten bent");
+    check_meta(&s, &bent(&s), &[[0, 0]], "kitten bent", None);
     let a = load("rocker_arm/rocker-arm2500.off");
     let b = load("torus.obj");
-    check_meta(&a, &b, &[[0, 0]], "rocker arm / torus");
+    let full = check_meta(&a, &b, &[[0, 0]], "rocker arm / torus", None);
+    // Pruned: flat vertices collapse on both surfaces alike.
+    let pruned = check_meta(&a, &b, &[[0, 0]], "rocker arm / torus, pruned at 10°", Some(10.0));
+    assert!(10 * pruned < 7 * full, "pruned {pruned} of {full} faces");
 }

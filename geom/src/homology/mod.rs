@@ -11,6 +11,7 @@
 //! - [`map`]: maps both ways through the two domains, rotation τ, induced map on H1.
 //! - [`compose`]: two planar disks composed into maps, the interior anchor warp.
 //! - [`overlay`]: the meta-mesh, both tessellations merged.
+//! - [`prune`]: the meta-mesh reduced to the edges needed above a dihedral-angle threshold.
 //! - [`features`]: feature curves (boundary loops included), the double cover they define.
 //! - [`feature_cut`]: a genus-0 surface cut open so that every feature lies on the boundary.
 //! - [`feature_domain`]: that disk on the unit circle, arcs shared by both meshes.
@@ -27,6 +28,7 @@ pub mod feature_map;
 pub mod features;
 pub mod map;
 pub mod overlay;
+pub mod prune;
 pub mod refine;
 pub mod search;
 pub mod word;

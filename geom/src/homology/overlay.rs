@@ -24,6 +24,8 @@ pub struct MetaMeshResult {
     pub on_target: Vec<P3>,
     /// Meta-vertices that are crossings of a source edge with a target edge.
     pub crossings: usize,
+    /// Per meta-vertex: whether it is such a crossing.
+    pub crossing: Vec<bool>,
 }
 
 impl MetaMeshResult {
@@ -115,6 +117,7 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
     let mut on_target: Vec<P3> = Vec::new();
     let mut faces: Vec<[u32; 3]> = Vec::new();
     let mut crossings = 0;
+    let mut crossing: Vec<bool> = Vec::new();
     let mut stamp = vec![u32::MAX; tt.len()];
     let bary = |tri: [Uv; 3], p: Uv| barycentric(tri, p).map(|x| x.clamp(0.0, 1.0));
     let point = |m: &Mesh, tri: [u32; 3], b: [f64; 3]| {
@@ -224,6 +227,7 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
                             let pt = point(&dt.mesh, ttri, bary(tp, pv.p));
                             on_source.push(ps);
                             on_target.push(pt);
+                            crossing.push(matches!(key, Key::X(..)));
                             if matches!(key, Key::X(..)) {
                                 crossings += 1;
                             }
@@ -251,5 +255,5 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
             Key::X(..) => {}
         }
     }
-    Ok(MetaMeshResult { faces, on_source, on_target, crossings })
+    Ok(MetaMeshResult { faces, on_source, on_target, crossings, crossing })
 }

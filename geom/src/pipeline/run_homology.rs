@@ -8,6 +8,7 @@ use super::spec::MapOptions;
 use crate::crossparam::smooth::SmoothReport;
 use crate::domain::LayoutStats;
 use crate::error::{Error, Result};
+use crate::homology::prune::{PruneOptions, prune_meta_mesh};
 use crate::homology::{HomologyMapOptions, homology_map, map::SideDomain};
 use crate::io::{self, Format};
 use crate::map::SurfaceMap;
@@ -48,6 +49,9 @@ pub struct MetaMeshStats {
     pub vertices: usize,
     pub faces: usize,
     pub crossings: usize,
+    /// Vertices removed by pruning below `dihedral_threshold_deg`, when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pruned_vertices: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
 }
@@ -99,9 +103,20 @@ pub fn run_homology(
     if o.meta_mesh {
         progress.report("meta_mesh", 0.0);
         let angle = std::f64::consts::TAU * r.side_shift as f64 / (4 * g) as f64;
-        let m = crate::homology::overlay::meta_mesh(&r.source, &r.target, angle)?;
-        let mut stats =
-            MetaMeshStats { vertices: m.on_source.len(), faces: m.faces.len(), crossings: m.crossings, error: None };
+        let mut m = crate::homology::overlay::meta_mesh(&r.source, &r.target, angle)?;
+        let mut pruned = None;
+        if let Some(deg) = o.dihedral_threshold_deg {
+            let p = prune_meta_mesh(&m, &PruneOptions { dihedral_threshold_deg: deg })?;
+            pruned = Some(p.removed_vertices);
+            m = p.mesh;
+        }
+        let mut stats = MetaMeshStats {
+            vertices: m.on_source.len(),
+            faces: m.faces.len(),
+            crossings: m.crossings,
+            pruned_vertices: pruned,
+            error: None,
+        };
         match m.meshes() {
             Ok((ms, mt)) => {
                 arts.push(Artifact {

@@ -54,6 +54,9 @@ pub struct MapOptions {
     /// planar domain (0 = the plain mean-value map). Spreads protrusions that the harmonic map
     /// crushes (a hand cut at the wrist) at the price of more folds between different shapes.
     pub domain_stretch_iterations: usize,
+    /// `homology` with `meta_mesh`: prune the meta-mesh, keeping only edges whose dihedral
+    /// angle exceeds this many degrees on either surface (flat vertices are collapsed).
+    pub dihedral_threshold_deg: Option<f64>,
 }
 
 impl Default for MapOptions {
@@ -67,6 +70,7 @@ impl Default for MapOptions {
             rotation: 0,
             meta_mesh: false,
             domain_stretch_iterations: 0,
+            dihedral_threshold_deg: None,
         }
     }
 }
@@ -203,6 +207,11 @@ impl JobSpec {
             .into());
         }
         let n = self.anchors.len();
+        if let Some(d) = self.options.dihedral_threshold_deg
+            && !(d.is_finite() && d > 0.0 && d <= 180.0)
+        {
+            return Err(InputError::Spec(format!("options.dihedral_threshold_deg must be in (0, 180], got {d}")).into());
+        }
         if self.features.len() > MAX_FEATURES {
             return Err(InputError::Features(format!(
                 "{} feature curves exceed the limit {MAX_FEATURES}",

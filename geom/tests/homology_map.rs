@@ -190,3 +190,34 @@ fn meta_mesh_kitten_bent_and_torus_pair() {
     let pruned = check_meta(&a, &b, &[[0, 0]], "rocker arm / torus, pruned at 10°", Some(10.0));
     assert!(10 * pruned < 7 * full, "pruned {pruned} of {full} faces");
 }
+
+/// An explicit curve matching picks the class that induces it on H1.
+#[test]
+fn a_curve_matching_selects_its_class() {
+    let s = load("torus.obj");
+    let (t, gt) = shuffled(&s);
+    let job = |m: &[&str]| JobSpec {
+        method: Method::Homology,
+        features: Vec::new(),
+        anchors: vec![[0, gt[0] as u64]],
+        options: MapOptions {
+            metric_samples: 2000,
+            matching: Some(m.iter().map(|x| x.to_string()).collect()),
+            ..Default::default()
+        },
+    };
+    let (r, _) = run_map(&job(&["a1 -> a1", "b1 -> b1"]), &s, &t, &mut NoProgress).unwrap();
+    assert_eq!(r.homology.unwrap().h1_reference, Some(vec![vec![1, 0], vec![0, 1]]));
+    let (r, _) = run_map(&job(&["a1 -> b1", "b1 -> -a1"]), &s, &t, &mut NoProgress).unwrap();
+    let h = r.homology.unwrap();
+    assert_eq!(h.h1_reference, Some(vec![vec![0, -1], vec![1, 0]]));
+    // A Dehn twist: a basis pair whose first loops lie in different classes realizes it.
+    let (r, _) = run_map(&job(&["a1 -> a1+b1", "b1 -> b1"]), &s, &t, &mut NoProgress).unwrap();
+    let h = r.homology.unwrap();
+    assert_eq!(h.h1_reference, Some(vec![vec![1, 0], vec![1, 1]]));
+    assert_ne!(h.basis[0], h.basis[1]);
+    // Orientation-reversing swaps are refused before any work.
+    let e = run_map(&job(&["a1 -> b1", "b1 -> a1"]), &s, &t, &mut NoProgress).unwrap_err();
+    assert_eq!(e.code(), "invalid_spec", "{e}");
+    assert!(e.to_string().contains("symplectic"), "{e}");
+}

@@ -28,6 +28,136 @@ pub struct Cohomology {
 /// `InvalidInput`-free: `Internal` when the surface has more than 64 generators or more than one
 /// boundary loop.
 pub fn z2_cohomology(mesh: &Mesh, tree_edges: &[EdgeId]) -> Result<Cohomology> {
+    let tc = tree_cotree(mesh, tree_edges)?;
+    let ne = mesh.n_edges();
+    let mut mask = vec![0u64; ne];
+    let mut rank = 0;
+    for (e, m) in mask.iter_mut().enumerate() {
+        if !tc.in_tree[e] && !tc.in_cotree[e] {
+            if rank >= 64 {
+                return Err(Error::Internal("cohomology: more than 64 generators".into()));
+            }
+            *m = 1 << rank;
+            rank += 1;
+        }
+    }
+    for &u in tc.order.iter().rev() {
+        if u == tc.root {
+            continue;
+        }
+        let pe = tc.parent_edge[u] as usize;
+        let m = tc.node_edges(mesh, u).iter().filter(|e| e.idx() != pe).fold(0u64, |acc, e| acc ^ mask[e.idx()]);
+        mask[pe] = m;
+    }
+    Ok(Cohomology { mask, rank })
+}
+
+/// Integer cocycles, one per leftover edge, on a closed surface: `value(e, k)` is cocycle `k` on
+/// edge `e` oriented from its first vertex to its second ([`Mesh::edge_vertices`]). They sum to
+/// zero around every face and form a basis of H¹(M; Z), so the class of a closed edge path in
+/// H1(M; Z) has coordinates `Σ ω_k(step)` (exactly what [`IntCohomology::class_of`] sums).
+#[derive(Debug, Clone)]
+pub struct IntCohomology {
+    pub rank: usize,
+    values: Vec<i32>,
+}
+
+impl IntCohomology {
+    pub fn value(&self, e: EdgeId, k: usize) -> i32 {
+        self.values[e.idx() * self.rank + k]
+    }
+
+    /// Coordinates of the closed path `steps` (consecutive vertices joined by edges; repeated
+    /// vertices are steps of length zero).
+    pub fn class_of(&self, mesh: &Mesh, steps: &[VertexId]) -> Option<Vec<i64>> {
+        let mut c = vec![0i64; self.rank];
+        for w in steps.windows(2) {
+            if w[0] == w[1] {
+                continue;
+            }
+            let e = super::cut::edge_between(mesh, w[0], w[1])?;
+            let sign = if mesh.edge_vertices(e)[0] == w[0] { 1 } else { -1 };
+            for (k, ck) in c.iter_mut().enumerate() {
+                *ck += i64::from(sign * self.value(e, k));
+            }
+        }
+        Some(c)
+    }
+}
+
+/// The integer cocycles of a closed mesh (tree–cotree, as [`z2_cohomology`], with signs).
+///
+/// # Errors
+/// `Internal` for a mesh with boundary.
+pub fn integer_cohomology(mesh: &Mesh) -> Result<IntCohomology> {
+    if !boundary_loops(mesh).is_empty() {
+        return Err(Error::Internal("integer cohomology: the mesh has a boundary".into()));
+    }
+    let tc = tree_cotree(mesh, &[])?;
+    let ne = mesh.n_edges();
+    let gens: Vec<usize> = (0..ne).filter(|&e| !tc.in_tree[e] && !tc.in_cotree[e]).collect();
+    let rank = gens.len();
+    let mut values = vec![0i32; ne * rank];
+    for (k, &e) in gens.iter().enumerate() {
+        values[e * rank + k] = 1;
+    }
+    // Face u: the sum over its half-edges (signed against each edge's own direction) is zero;
+    // peeling the cotree from its leaves fixes the parent edge's value.
+    for &u in tc.order.iter().rev() {
+        if u == tc.root {
+            continue;
+        }
+        let pe = tc.parent_edge[u] as usize;
+        let f = crate::mesh::FaceId::from_idx(u);
+        let mut sum = vec![0i32; rank];
+        let mut pe_sign = 0;
+        for k in 0..3 {
+            let h = crate::mesh::HalfedgeId::of(f, k);
+            let e = mesh.edge(h);
+            let sign = if mesh.edge_vertices(e)[0] == mesh.tail(h) { 1 } else { -1 };
+            if e.idx() == pe {
+                pe_sign = sign;
+                continue;
+            }
+            for (j, s) in sum.iter_mut().enumerate() {
+                *s += sign * values[e.idx() * rank + j];
+            }
+        }
+        for (j, s) in sum.iter().enumerate() {
+            values[pe * rank + j] = -pe_sign * s;
+        }
+    }
+    Ok(IntCohomology { rank, values })
+}
+
+/// A spanning tree of the vertices and one of the dual graph that avoids it.
+struct TreeCotree {
+    in_tree: Vec<bool>,
+    in_cotree: Vec<bool>,
+    /// Dual nodes in BFS order from the root.
+    order: Vec<usize>,
+    parent_edge: Vec<u32>,
+    root: usize,
+    cap_edges: Vec<EdgeId>,
+    nf: usize,
+}
+
+impl TreeCotree {
+    /// The edges around dual node `u` (a face, or the cap).
+    fn node_edges(&self, mesh: &Mesh, u: usize) -> Vec<EdgeId> {
+        if u == self.nf {
+            self.cap_edges.clone()
+        } else {
+            (0..3).map(|k| mesh.edge(crate::mesh::HalfedgeId::of(crate::mesh::FaceId::from_idx(u), k))).collect()
+        }
+    }
+}
+
+/// Builds the tree (containing every edge given, then spanning all vertices) and the cotree.
+///
+/// # Errors
+/// `Internal` when the surface has more than one boundary loop.
+fn tree_cotree(mesh: &Mesh, tree_edges: &[EdgeId]) -> Result<TreeCotree> {
     let (nv, ne, nf) = (mesh.n_vertices(), mesh.n_edges(), mesh.n_faces());
     let loops = boundary_loops(mesh);
     if loops.len() > 1 {
@@ -99,26 +229,7 @@ pub fn z2_cohomology(mesh: &Mesh, tree_edges: &[EdgeId]) -> Result<Cohomology> {
             }
         }
     }
-    let mut mask = vec![0u64; ne];
-    let mut rank = 0;
-    for e in 0..ne {
-        if !in_tree[e] && !in_cotree[e] {
-            if rank >= 64 {
-                return Err(Error::Internal("cohomology: more than 64 generators".into()));
-            }
-            mask[e] = 1 << rank;
-            rank += 1;
-        }
-    }
-    for &u in order.iter().rev() {
-        if u == root {
-            continue;
-        }
-        let pe = parent_edge[u] as usize;
-        let m = node_edges(u).iter().filter(|e| e.idx() != pe).fold(0u64, |acc, e| acc ^ mask[e.idx()]);
-        mask[pe] = m;
-    }
-    Ok(Cohomology { mask, rank })
+    Ok(TreeCotree { in_tree, in_cotree, order, parent_edge, root, cap_edges, nf })
 }
 
 struct UnionFind(Vec<u32>);
@@ -147,7 +258,7 @@ impl UnionFind {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::{VertexId, shapes};
+    use crate::mesh::shapes;
 
     fn mask_of(m: &Mesh, c: &Cohomology, path: &[u32]) -> u64 {
         path.windows(2)
@@ -170,6 +281,29 @@ mod tests {
         // The boundary of one face separates (bounds that face).
         let f = t.face(crate::mesh::FaceId(0)).map(|v| v.0);
         assert_eq!(mask_of(&t, &c, &[f[0], f[1], f[2], f[0]]), 0);
+    }
+
+    #[test]
+    fn integer_classes_of_a_torus() {
+        let (n, m) = (12usize, 6usize);
+        let t = shapes::torus(n, m, 1.0, 0.3);
+        let c = integer_cohomology(&t).unwrap();
+        assert_eq!(c.rank, 2);
+        let path = |p: &[u32]| p.iter().map(|&v| VertexId(v)).collect::<Vec<_>>();
+        let tube: Vec<u32> = (0..=m).map(|j| (j % m) as u32).collect();
+        let ring: Vec<u32> = (0..=n).map(|i| ((i % n) * m) as u32).collect();
+        let (a, b) = (c.class_of(&t, &path(&tube)).unwrap(), c.class_of(&t, &path(&ring)).unwrap());
+        // Independent over Z (a unimodular pair), reversal negates, twice is twice.
+        assert_eq!((a[0] * b[1] - a[1] * b[0]).abs(), 1, "{a:?} {b:?}");
+        let back: Vec<u32> = tube.iter().rev().copied().collect();
+        assert_eq!(c.class_of(&t, &path(&back)).unwrap(), a.iter().map(|x| -x).collect::<Vec<_>>());
+        let twice: Vec<u32> = tube.iter().chain(&tube[1..]).copied().collect();
+        assert_eq!(c.class_of(&t, &path(&twice)).unwrap(), a.iter().map(|x| 2 * x).collect::<Vec<_>>());
+        // Every face boundary is null-homologous.
+        for f in t.faces() {
+            let f = f.map(|v| v.0);
+            assert_eq!(c.class_of(&t, &path(&[f[0], f[1], f[2], f[0]])).unwrap(), vec![0, 0]);
+        }
     }
 
     #[test]

@@ -150,6 +150,13 @@ pub fn map_between(
     Ok(HomologyMapResult { source_to_target, target_to_source, h1, side_shift: shift, warped, source: s, target: t })
 }
 
+/// The induced map on H1 when the source domain is turned by `rotation` steps.
+pub fn induced_h1_for(s: &CanonicalBasisResult, t: &CanonicalBasisResult, rotation: usize) -> Vec<Vec<i32>> {
+    let g = s.genus();
+    let shift = if g == 1 { rotation % 4 } else { 4 * (rotation % g) };
+    induced_h1(s, t, shift)
+}
+
 /// The induced map on H1 in the two canonical bases: source side `k` lands on target side
 /// `k + shift`; the image's coordinates come from its intersection numbers with the target
 /// basis (`x_j = γ·b_j`, `y_j = −γ·a_j`, since `a_j·b_j = 1`).

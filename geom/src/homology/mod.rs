@@ -7,8 +7,10 @@
 //! - [`search`]: shortest non-separating loops and side-to-side paths on a cut surface.
 //! - [`word`]: boundary words, the canonical rotation, intersection numbers at the base.
 //! - [`basis`]: the canonical basis itself.
+//! - [`classes`]: integer classes of basis loops; H1 in reference bases.
 //! - [`domain`]: the cut disk on the regular 4g-gon.
 //! - [`map`]: maps both ways through the two domains, rotation τ, induced map on H1.
+//! - [`matching`]: an explicit curve matching (`a1 -> b1`, …) realized by basis and rotation.
 //! - [`compose`]: two planar disks composed into maps, the interior anchor warp.
 //! - [`overlay`]: the meta-mesh, both tessellations merged.
 //! - [`prune`]: the meta-mesh reduced to the edges needed above a dihedral-angle threshold.
@@ -18,6 +20,7 @@
 //! - [`feature_map`]: maps both ways that take every feature onto its partner.
 
 pub mod basis;
+pub mod classes;
 pub mod cocycle;
 pub mod compose;
 pub mod cut;
@@ -27,6 +30,7 @@ pub mod feature_domain;
 pub mod feature_map;
 pub mod features;
 pub mod map;
+pub mod matching;
 pub mod overlay;
 pub mod prune;
 pub mod refine;

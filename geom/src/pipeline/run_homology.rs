@@ -8,6 +8,7 @@ use super::spec::MapOptions;
 use crate::crossparam::smooth::SmoothReport;
 use crate::domain::LayoutStats;
 use crate::error::{Error, Result};
+use crate::homology::matching::{MatchingOptions, find_matching, parse_matching, reference_frame, reference_h1};
 use crate::homology::prune::{PruneOptions, prune_meta_mesh};
 use crate::homology::{HomologyMapOptions, homology_map, map::SideDomain};
 use crate::io::{self, Format};
@@ -32,6 +33,10 @@ pub struct HomologyReport {
     pub anchor_warp: bool,
     /// Induced map on H1 (`a1, b1, …`), column `j` the image of source loop `j`.
     pub h1: Vec<Vec<i32>>,
+    /// The same map read in the reference bases (basis 0 on each mesh), when other bases were
+    /// used or a matching was asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub h1_reference: Option<Vec<Vec<i32>>>,
     /// Base vertices (the first anchor pair).
     pub base: [u32; 2],
     /// Subdivision rounds the bases needed.
@@ -75,15 +80,39 @@ pub fn run_homology(
     let o = &spec.options;
     clock.lap("setup");
     progress.report("basis", 0.0);
+    let (mut basis, mut rotation, mut want) = (o.basis, o.rotation, None);
+    if let Some(entries) = &o.matching {
+        let g = crate::topology::summary(source).genus.max(0) as usize;
+        let w = parse_matching(g, entries)?;
+        let found = find_matching(source, target, pairs[0], &w, &MatchingOptions::default())?;
+        (basis, rotation, want) = (found.basis, found.rotation, Some(w));
+        clock.lap("matching");
+    }
     let hopts = HomologyMapOptions {
-        basis: o.basis,
-        rotation: o.rotation,
+        basis,
+        rotation,
         max_subdivisions: None,
         // Off by default: reweighting each domain on its own lowers each map's stretch but
         // raised the composed map's folds on every different-shape pair measured.
         stretch_iterations: o.domain_stretch_iterations,
     };
     let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
+    // The induced map read in the reference bases (basis 0 on each mesh), when the bases used
+    // are others or a matching was asked for.
+    let h1_reference = if want.is_some() || basis != [0, 0] {
+        let (fs, ft) = both(|| reference_frame(target, pairs[0].1), || reference_frame(source, pairs[0].0))?;
+        let (fs, ft) = (fs?, ft?);
+        Some(reference_h1((source, target), (&fs.1, &ft.1), (&r.source.basis, &r.target.basis), &r.h1)?)
+    } else {
+        None
+    };
+    if let (Some(w), Some(got)) = (&want, &h1_reference)
+        && got != w
+    {
+        return Err(Error::Numerical(format!(
+            "matching: the bases refined for the map induce {got:?} instead of {w:?}"
+        )));
+    }
     clock.lap("basis_domain_map");
     progress.check()?;
     let f = finish_pair(source, target, (&r.source_to_target, &r.target_to_source), &pairs, (&[], &[]), o, progress)?;
@@ -137,11 +166,12 @@ pub fn run_homology(
     }
     let report = HomologyReport {
         genus: g,
-        basis: o.basis,
-        rotation: o.rotation,
+        basis,
+        rotation,
         side_shift: r.side_shift,
         anchor_warp: r.warped,
         h1: r.h1.clone(),
+        h1_reference,
         base: [pairs[0].0.0, pairs[0].1.0],
         subdivisions: [r.source.basis.subdivisions, r.target.basis.subdivisions],
         loop_lengths: [len(&r.source), len(&r.target)],

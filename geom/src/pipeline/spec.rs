@@ -57,6 +57,10 @@ pub struct MapOptions {
     /// `homology` with `meta_mesh`: prune the meta-mesh, keeping only edges whose dihedral
     /// angle exceeds this many degrees on either surface (flat vertices are collapsed).
     pub dihedral_threshold_deg: Option<f64>,
+    /// `homology`: where each source loop goes, e.g. `["a1 -> b1", "b1 -> -a1"]` or
+    /// `["a1 -> a1+b1", "b1 -> b1"]`; overrides `basis` and `rotation` with a class that induces
+    /// it on H1 (searched over the first few bases and every rotation).
+    pub matching: Option<Vec<String>>,
 }
 
 impl Default for MapOptions {
@@ -71,6 +75,7 @@ impl Default for MapOptions {
             meta_mesh: false,
             domain_stretch_iterations: 0,
             dihedral_threshold_deg: None,
+            matching: None,
         }
     }
 }

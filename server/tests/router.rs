@@ -211,6 +211,25 @@ async fn homology_job_through_the_queue() {
     for n in ["basis_source.json", "domain_target.obj", "meta_source.obj", "meta_target.obj", "metrics.json"] {
         assert!(names.contains(&n), "{n} missing from {names:?}");
     }
+    // A disk with a feature curve (and its boundary as a feature): mapped exactly.
+    let g = geom::mesh::shapes::grid(8);
+    let gt =
+        g.with_positions(g.positions().iter().map(|p| geom::mesh::P3::new(p.x * 1.5, p.y, 0.3 * p.x * p.y)).collect());
+    let (_, a) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&g, Format::Off))).await;
+    let (_, b) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&gt.unwrap(), Format::Off))).await;
+    let spec = json!({"method": "homology", "anchors": [[0, 0]],
+        "features": [{"source": [40, 41, 42], "target": [40, 41, 42]}]});
+    let body = json!({"source": a["id"], "target": b["id"], "spec": spec}).to_string();
+    let req = Request::post("/v1/jobs").header("content-type", "application/json").body(Body::from(body)).unwrap();
+    let (st, _, job) = call(&t, req).await;
+    assert_eq!(st, StatusCode::ACCEPTED, "{}", String::from_utf8_lossy(&job));
+    let id = serde_json::from_slice::<Value>(&job).unwrap()["id"].as_str().unwrap().to_string();
+    assert_eq!(t.worker.run_once(&rx).await.unwrap(), Ran::Ran { job: id.clone(), outcome: "succeeded".into() });
+    let (_, done) = json_call(&t, "GET", &format!("/v1/jobs/{id}"), Body::empty()).await;
+    let f = &done["result"]["features"];
+    assert_eq!(f["curves"], 2, "{done}");
+    assert!(f["feature_error"][0].as_f64().unwrap() <= 1e-9, "{done}");
+    assert_eq!(done["result"]["source_to_target"]["flipped_faces"], 0, "{done}");
     // Genus 0 has no homology basis: refused before queueing.
     let (sp, _) = sphere_pair();
     let (_, c) = json_call(&t, "POST", "/v1/meshes", Body::from(sp)).await;

@@ -4,11 +4,9 @@
 //! and bad curves are refused with a typed error.
 
 use geom::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
-use geom::io::ReadOptions;
 use geom::mesh::{Mesh, VertexId};
 use geom::pipeline::{FeatureSpec, JobSpec, MapOptions, MapReport, Method, run_map};
 use geom::progress::NoProgress;
-use geom::topology::Locator;
 
 mod common;
 use common::{bent, load, twisted};
@@ -90,12 +88,7 @@ fn check(s: &Mesh, t: &Mesh, sp: &JobSpec) -> (MapReport, f64) {
     assert_eq!(f.domain_flips, [0, 0]);
     assert_eq!(f.doubled_genus, f.curves - 1);
     assert_eq!((report.source_to_target.flipped_faces, report.target_to_source.flipped_faces), (0, 0));
-    let obj = arts.iter().find(|a| a.name == "source_on_target.obj").unwrap();
-    let mapped = geom::io::read(&obj.bytes, &ReadOptions::default()).unwrap().mesh;
-    assert_eq!(mapped.faces(), s.faces(), "equal connectivity");
-    let loc = Locator::new(t).unwrap();
-    let off = mapped.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
-    assert!(off <= 1e-9 * t.bbox_diagonal(), "off surface {off}");
+    let mapped = common::source_on_target(&arts, s, t);
     let gt =
         mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(i as u32))).norm()).sum::<f64>()
             / mapped.n_vertices() as f64

@@ -47,12 +47,7 @@ fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, bas
     ] {
         assert!(names.contains(&n), "missing {n}");
     }
-    let obj = arts.iter().find(|a| a.name == "source_on_target.obj").unwrap();
-    let mapped = geom::io::read(&obj.bytes, &ReadOptions::default()).unwrap().mesh;
-    assert_eq!(mapped.faces(), s.faces(), "equal connectivity");
-    let loc = Locator::new(t).unwrap();
-    let off = mapped.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
-    assert!(off <= 1e-9 * t.bbox_diagonal(), "off surface {off}");
+    let mapped = common::source_on_target(&arts, s, t);
     let gt_mean =
         mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(gt[i]))).norm()).sum::<f64>()
             / mapped.n_vertices() as f64

@@ -92,23 +92,34 @@ pub fn domain_unchecked(basis: &CanonicalBasisResult, stretch_iterations: usize)
             }
         }
     }
-    let boundary: Vec<VertexId> = walk.clone();
-    let mut sys = FixedBoundarySystem::new(disk, &boundary)?;
+    let (uv, residual) = solve_disk(disk, walk, &fixed, stretch_iterations)?;
+    let injectivity = exact_orientation(disk, &uv);
+    Ok(FundamentalDomainResult { uv, polygon, injectivity, residual })
+}
+
+/// The mean-value map of `disk` with `boundary` held at `fixed` (indexed by vertex), then
+/// `stretch_iterations` rounds of reweighting: the harmonic map squeezes whatever lies far
+/// from the boundary, and Yoshizawa–Belyaev–Seidel reweighting (positive weights, so still
+/// bijective) spreads it out again. Returns the positions and the solve's relative residual.
+///
+/// # Errors
+/// When a solve fails.
+pub(super) fn solve_disk(
+    disk: &Mesh,
+    boundary: &[VertexId],
+    fixed: &[Uv],
+    stretch_iterations: usize,
+) -> Result<(Vec<Uv>, f64)> {
+    let mut sys = FixedBoundarySystem::new(disk, boundary)?;
     sys.prepare_lu()?;
     let w = directed_weights(disk, Weights::MeanValue);
     let (uv, residual) = sys.factor_weights(&w, false)?.solve_with_residual::<2>(&|v| fixed[v.idx()])?;
-    // The harmonic map squeezes whatever lies far from the cut; Yoshizawa-Belyaev-Seidel
-    // reweighting (positive weights, so still bijective) spreads it out again.
-    let (uv, residual) = if stretch_iterations > 0 {
-        let so = StretchOptions { iterations: stretch_iterations, ..Default::default() };
-        let r = minimize_stretch(disk, &sys, &w, uv, &|v| fixed[v.idx()], &so)?;
-        let res = if r.rounds > 0 { r.residual } else { residual };
-        (r.uv, res)
-    } else {
-        (uv, residual)
-    };
-    let injectivity = exact_orientation(disk, &uv);
-    Ok(FundamentalDomainResult { uv, polygon, injectivity, residual })
+    if stretch_iterations == 0 {
+        return Ok((uv, residual));
+    }
+    let so = StretchOptions { iterations: stretch_iterations, ..Default::default() };
+    let r = minimize_stretch(disk, &sys, &w, uv, &|v| fixed[v.idx()], &so)?;
+    Ok((r.uv, if r.rounds > 0 { r.residual } else { residual }))
 }
 
 /// Orientation of every face by the exact predicate: flipped below zero, degenerate at exactly

@@ -8,11 +8,10 @@
 //! (a link that runs beside a feature), and no corner ever carries a degenerate triangle. Arcs
 //! are sized by each side's share of its boundary's length, averaged over the two meshes.
 
-use super::domain::exact_orientation;
+use super::domain::{exact_orientation, solve_disk};
 use super::feature_cut::FeatureCutResult;
 use crate::error::{Error, Result};
-use crate::linalg::{FixedBoundarySystem, Weights, directed_weights};
-use crate::param::{InjectivityReport, StretchOptions, Uv, minimize_stretch};
+use crate::param::{InjectivityReport, Uv};
 
 /// One mesh's disk on the circle.
 #[derive(Debug, Clone)]
@@ -72,18 +71,7 @@ pub fn feature_domain(cut: &FeatureCutResult, arcs: &[f64], stretch_iterations: 
             t += (disk.position(w) - disk.position(v)).norm();
         }
     }
-    let mut sys = FixedBoundarySystem::new(disk, walk)?;
-    sys.prepare_lu()?;
-    let w = directed_weights(disk, Weights::MeanValue);
-    let (uv, residual) = sys.factor_weights(&w, false)?.solve_with_residual::<2>(&|v| fixed[v.idx()])?;
-    let (uv, residual) = if stretch_iterations > 0 {
-        let so = StretchOptions { iterations: stretch_iterations, ..Default::default() };
-        let r = minimize_stretch(disk, &sys, &w, uv, &|v| fixed[v.idx()], &so)?;
-        let res = if r.rounds > 0 { r.residual } else { residual };
-        (r.uv, res)
-    } else {
-        (uv, residual)
-    };
+    let (uv, residual) = solve_disk(disk, walk, &fixed, stretch_iterations)?;
     let injectivity = exact_orientation(disk, &uv);
     if !injectivity.is_injective() {
         return Err(Error::Numerical(format!(

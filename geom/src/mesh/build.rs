@@ -419,21 +419,7 @@ fn link(
     attributes: VertexAttributes,
 ) -> Result<Mesh> {
     let nv = positions.len();
-    let nh = tris.len() * 3;
-    let mut edge_of = vec![EdgeId::INVALID; nh];
-    let mut edge_he = Vec::with_capacity(nh / 2 + 1);
-    for h in 0..nh {
-        if edge_of[h].is_valid() {
-            continue;
-        }
-        let e = EdgeId(edge_he.len() as u32);
-        edge_of[h] = e;
-        edge_he.push(HalfedgeId(h as u32));
-        let t = twin[h];
-        if t.is_valid() {
-            edge_of[t.idx()] = e;
-        }
-    }
+    let (edge_of, edge_he) = edges_from_twins(&twin);
     let mut vertex_he = vec![HalfedgeId::INVALID; nv];
     for (v, slot) in vertex_he.iter_mut().enumerate() {
         let hs = &st.he[st.off[v] as usize..st.off[v + 1] as usize];
@@ -463,4 +449,24 @@ fn link(
         }
     }
     Ok(mesh)
+}
+
+/// Undirected edges from the twin table: per half-edge its edge, per edge its first half-edge
+/// (the only one on the boundary).
+pub(super) fn edges_from_twins(twin: &[HalfedgeId]) -> (Vec<EdgeId>, Vec<HalfedgeId>) {
+    let nh = twin.len();
+    let mut edge_of = vec![EdgeId::INVALID; nh];
+    let mut edge_he = Vec::with_capacity(nh / 2 + 1);
+    for h in 0..nh {
+        if edge_of[h].is_valid() {
+            continue;
+        }
+        let e = EdgeId(edge_he.len() as u32);
+        edge_of[h] = e;
+        edge_he.push(HalfedgeId(h as u32));
+        if twin[h].is_valid() {
+            edge_of[twin[h].idx()] = e;
+        }
+    }
+    (edge_of, edge_he)
 }

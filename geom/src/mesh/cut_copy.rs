@@ -3,7 +3,7 @@
 //! the cut, and no validation pass is needed (each vertex copy is one wedge of a manifold fan,
 //! so the result is manifold by construction).
 
-use super::{EdgeId, HalfedgeId, Mesh, P3, VertexAttributes, VertexId};
+use super::{HalfedgeId, Mesh, P3, VertexAttributes, VertexId};
 
 impl Mesh {
     /// The mesh with the same faces re-indexed to `faces` (one entry per face, corners in the
@@ -18,19 +18,7 @@ impl Mesh {
                 if cut.get(e.idx()).copied().unwrap_or(false) { HalfedgeId::INVALID } else { self.twin[h] }
             })
             .collect();
-        let mut edge_of = vec![EdgeId::INVALID; nh];
-        let mut edge_he = Vec::with_capacity(nh / 2 + 1);
-        for h in 0..nh {
-            if edge_of[h].is_valid() {
-                continue;
-            }
-            let e = EdgeId(edge_he.len() as u32);
-            edge_of[h] = e;
-            edge_he.push(HalfedgeId(h as u32));
-            if twin[h].is_valid() {
-                edge_of[twin[h].idx()] = e;
-            }
-        }
+        let (edge_of, edge_he) = super::build::edges_from_twins(&twin);
         let mut vertex_he = vec![HalfedgeId::INVALID; positions.len()];
         for (f, t) in faces.iter().enumerate() {
             for (k, v) in t.iter().enumerate() {

@@ -4,15 +4,13 @@
 
 use super::artifacts;
 use super::run::{Artifact, Clock, MapReport};
-use super::run_homology::{finish_pair, finish_report, json_artifact};
+use super::run_homology::{finish_pair, finish_report, json_artifact, pair_report, planar_obj};
 use super::spec::JobSpec;
-use crate::domain::LayoutStats;
 use crate::error::Result;
 use crate::homology::feature_cut::{FeatureCutResult, Side, SideKind};
 use crate::homology::feature_map::{FeatureSide, feature_error, feature_map};
 use crate::homology::features::{Curve, CurveKind};
-use crate::io::{self, Format};
-use crate::mesh::{Mesh, P3, VertexId};
+use crate::mesh::{Mesh, VertexId};
 use crate::progress::Progress;
 use serde::Serialize;
 use serde_json::json;
@@ -72,7 +70,7 @@ pub(super) fn run_features(
     clock.lap("smooth_metrics");
     progress.check()?;
     let (sc, tc) = (&r.source.cut.curves, &r.target.cut.curves);
-    let report = FeatureReport {
+    let report_f = FeatureReport {
         curves: sc.len(),
         order: r.order.clone(),
         kinds: sc.iter().map(|c| c.kind).collect(),
@@ -88,20 +86,8 @@ pub(super) fn run_features(
     arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });
     arts.push(Artifact { name: "domain_target.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.target)? });
     clock.lap("artifacts");
-    let mut report = MapReport {
-        method: spec.method.name(),
-        anchors: pairs.len(),
-        patches: 1,
-        source_vertices: source.n_vertices(),
-        target_vertices: target.n_vertices(),
-        layout: LayoutStats::default(),
-        source_to_target: f.m1,
-        target_to_source: f.m2,
-        timings_ms: Vec::new(),
-        smoothing: f.smoothing,
-        homology: None,
-        features: Some(report),
-    };
+    let mut report = pair_report(spec, pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
+    report.features = Some(report_f);
     finish_report(&mut report, clock, &mut arts)?;
     progress.report("done", 1.0);
     Ok((report, arts))
@@ -154,7 +140,5 @@ fn cut_json(fs: &FeatureSide, mesh: &Mesh) -> serde_json::Value {
 
 /// The planar disk as a mesh at z = 0.
 fn domain_obj(fs: &FeatureSide) -> Result<Vec<u8>> {
-    let pos: Vec<P3> = fs.domain.uv.iter().map(|p| P3::new(p[0], p[1], 0.0)).collect();
-    let m = Mesh::from_triangles(pos, &fs.cut.disk.mesh.face_indices())?;
-    Ok(io::write(&m, Format::Obj))
+    planar_obj(&fs.domain.uv, &fs.cut.disk.mesh)
 }

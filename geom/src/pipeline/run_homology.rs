@@ -164,7 +164,7 @@ pub fn run_homology(
         meta = Some(stats);
         clock.lap("meta_mesh");
     }
-    let report = HomologyReport {
+    let report_h = HomologyReport {
         genus: g,
         basis,
         rotation,
@@ -182,20 +182,8 @@ pub fn run_homology(
     arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });
     arts.push(Artifact { name: "domain_target.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.target)? });
     clock.lap("artifacts");
-    let mut report = MapReport {
-        method: spec.method.name(),
-        anchors: pairs.len(),
-        patches: 1,
-        source_vertices: source.n_vertices(),
-        target_vertices: target.n_vertices(),
-        layout: LayoutStats::default(),
-        source_to_target: f.m1,
-        target_to_source: f.m2,
-        timings_ms: Vec::new(),
-        smoothing: f.smoothing,
-        homology: Some(report),
-        features: None,
-    };
+    let mut report = pair_report(spec, pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
+    report.homology = Some(report_h);
     finish_report(&mut report, clock, &mut arts)?;
     progress.report("done", 1.0);
     Ok((report, arts))
@@ -295,7 +283,36 @@ fn basis_json(sd: &SideDomain) -> serde_json::Value {
 
 /// The planar 4g-gon as a mesh at z = 0.
 fn domain_obj(sd: &SideDomain) -> Result<Vec<u8>> {
-    let pos: Vec<P3> = sd.domain.uv.iter().map(|p| P3::new(p[0], p[1], 0.0)).collect();
-    let m = Mesh::from_triangles(pos, &sd.basis.disk.mesh.face_indices())?;
+    planar_obj(&sd.domain.uv, &sd.basis.disk.mesh)
+}
+
+/// A planar domain (`uv` per vertex of `disk`) as an OBJ mesh at z = 0.
+pub(super) fn planar_obj(uv: &[crate::param::Uv], disk: &Mesh) -> Result<Vec<u8>> {
+    let pos: Vec<P3> = uv.iter().map(|p| P3::new(p[0], p[1], 0.0)).collect();
+    let m = Mesh::from_triangles(pos, &disk.face_indices())?;
     Ok(io::write(&m, Format::Obj))
+}
+
+/// The report of a one-patch pair job, before its method's own section.
+pub(super) fn pair_report(
+    spec: &JobSpec,
+    anchors: usize,
+    meshes: (&Mesh, &Mesh),
+    metrics: (MapMetrics, MapMetrics),
+    smoothing: SmoothReport,
+) -> MapReport {
+    MapReport {
+        method: spec.method.name(),
+        anchors,
+        patches: 1,
+        source_vertices: meshes.0.n_vertices(),
+        target_vertices: meshes.1.n_vertices(),
+        layout: LayoutStats::default(),
+        source_to_target: metrics.0,
+        target_to_source: metrics.1,
+        timings_ms: Vec::new(),
+        smoothing,
+        homology: None,
+        features: None,
+    }
 }

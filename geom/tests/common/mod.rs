@@ -92,3 +92,15 @@ pub fn bent(m: &Mesh) -> Mesh {
         .collect();
     m.with_positions(pos).unwrap()
 }
+
+/// The job's `source_on_target.obj`, checked: the source's faces, every vertex on the target
+/// (within 1e-9 of its diagonal).
+pub fn source_on_target(arts: &[geom::pipeline::Artifact], s: &Mesh, t: &Mesh) -> Mesh {
+    let obj = arts.iter().find(|a| a.name == "source_on_target.obj").expect("source_on_target.obj");
+    let mapped = geom::io::read(&obj.bytes, &ReadOptions::default()).unwrap().mesh;
+    assert_eq!(mapped.faces(), s.faces(), "equal connectivity");
+    let loc = geom::topology::Locator::new(t).unwrap();
+    let off = mapped.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
+    assert!(off <= 1e-9 * t.bbox_diagonal(), "off surface {off}");
+    mapped
+}

@@ -36,7 +36,6 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
         let faces = &map.face;
         let against = |p: P3, pos: &[P3]| flipped_in_star(source, target, v, p, f, pos, faces);
         let before = against(pos[vi], &pos);
-        let ok_faces = |p: P3, pos: &[P3]| against(p, pos) <= before;
         // Towards the centroid first, then onto the face's corners (nearest first).
         let mut cands: Vec<[f64; 3]> =
             [0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0].iter().map(|&t| b.map(|x| x * (1.0 - t) + t / 3.0)).collect();
@@ -47,10 +46,27 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
             e[k] = 1.0;
             cands.push(e);
         }
-        for nb in cands {
-            let [p0, p1, p2] = target.face_points(f);
+        // Then into the faces around its face's corners (centroid, then half-way to each corner):
+        // a point on a sliver next to a large face can be hidden anywhere on the sliver.
+        let around: Vec<crate::FaceId> = target.face(f).iter().flat_map(|&c| target.vertex_faces(c)).collect();
+        let halfway: Vec<[f64; 3]> = (0..3)
+            .map(|k| {
+                let mut e = [1.0 / 6.0; 3];
+                e[k] = 2.0 / 3.0;
+                e
+            })
+            .collect();
+        let tries = cands.into_iter().map(|nb| (f, nb)).chain(
+            around
+                .into_iter()
+                .filter(|&g| g != f)
+                .flat_map(|g| std::iter::once((g, [1.0 / 3.0; 3])).chain(halfway.iter().map(move |&nb| (g, nb)))),
+        );
+        for (g, nb) in tries {
+            let [p0, p1, p2] = target.face_points(g);
             let p = P3::from(p0.coords * nb[0] + p1.coords * nb[1] + p2.coords * nb[2]);
-            if index.query(&p).distance <= tol && ok_faces(p, &pos) {
+            if index.query(&p).distance <= tol && flipped_in_star(source, target, v, p, g, &pos, &map.face) <= before {
+                map.face[vi] = g;
                 map.bary[vi] = nb;
                 pos[vi] = p;
                 moved += 1;

@@ -81,3 +81,22 @@ fn homology_refusals() {
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("genus mismatch"), "{err}");
 }
+
+#[test]
+fn bad_feature_curves_and_matchings() {
+    // Vertices 0 and 500 of the cow are not joined by an edge.
+    let spec = r#"{"method": "homology", "anchors": [], "features": [{"source": [0, 500], "target": [0, 500]}]}"#;
+    let (code, err) = run_map("cow.off", "cow.off", spec, "feat1");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[invalid_features]") && err.contains("not joined by an edge"), "{err}");
+    // Feature curves on a genus-1 surface are not supported.
+    let spec = r#"{"method": "homology", "anchors": [[0, 0]], "features": [{"source": [0, 1], "target": [0, 1]}]}"#;
+    let (code, err) = run_map("torus.obj", "torus.obj", spec, "feat2");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[topology_mismatch]"), "{err}");
+    // A matching that reverses orientation.
+    let spec = r#"{"method": "homology", "anchors": [[0, 0]], "options": {"matching": ["a1 -> b1", "b1 -> a1"]}}"#;
+    let (code, err) = run_map("torus.obj", "torus.obj", spec, "match");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("[invalid_spec]") && err.contains("symplectic"), "{err}");
+}

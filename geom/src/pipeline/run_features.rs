@@ -4,7 +4,7 @@
 
 use super::artifacts;
 use super::run::{Artifact, Clock, MapReport};
-use super::run_homology::{finish_pair, finish_report, json_artifact, pair_report, planar_obj};
+use super::run_homology::{finish_pair, finish_report, json_artifact, morph_glb, pair_report, planar_obj};
 use super::spec::JobSpec;
 use crate::error::Result;
 use crate::homology::feature_cut::{FeatureCutResult, Side, SideKind};
@@ -81,6 +81,7 @@ pub(super) fn run_features(
         domain_flips: [r.source.domain.injectivity.flipped, r.target.domain.injectivity.flipped],
     };
     let mut arts = artifacts::maps_and_meshes(&f.s2t, &f.t2s, &f.on_target, &f.on_source);
+    arts.push(morph_glb(source, f.on_target.positions()));
     arts.push(json_artifact("basis_source.json", &cut_json(&r.source, source))?);
     arts.push(json_artifact("basis_target.json", &cut_json(&r.target, target))?);
     arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });

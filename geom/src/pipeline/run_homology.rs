@@ -129,6 +129,7 @@ pub fn run_homology(
     };
     let mut arts = artifacts::maps_and_meshes(&f.s2t, &f.t2s, &f.on_target, &f.on_source);
     let mut meta = None;
+    let mut morph = None;
     if o.meta_mesh {
         progress.report("meta_mesh", 0.0);
         let angle = std::f64::consts::TAU * r.side_shift as f64 / (4 * g) as f64;
@@ -158,6 +159,7 @@ pub fn run_homology(
                     content_type: "model/obj",
                     bytes: io::write(&mt, Format::Obj),
                 });
+                morph = Some(morph_glb(&ms, mt.positions()));
             }
             Err(e) => stats.error = Some(e.to_string()),
         }
@@ -177,6 +179,9 @@ pub fn run_homology(
         loop_lengths: [len(&r.source), len(&r.target)],
         meta_mesh: meta,
     };
+    // The morph: the meta-mesh from source to target when there is one (every detail of both),
+    // else the source mesh to its image on the target.
+    arts.push(morph.unwrap_or_else(|| morph_glb(source, f.on_target.positions())));
     arts.push(json_artifact("basis_source.json", &basis_json(&r.source))?);
     arts.push(json_artifact("basis_target.json", &basis_json(&r.target))?);
     arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });
@@ -284,6 +289,15 @@ fn basis_json(sd: &SideDomain) -> serde_json::Value {
 /// The planar 4g-gon as a mesh at z = 0.
 fn domain_obj(sd: &SideDomain) -> Result<Vec<u8>> {
     planar_obj(&sd.domain.uv, &sd.basis.disk.mesh)
+}
+
+/// `morph.glb`: `base` with one morph target, the same vertices at `to` (glTF 2.0, binary).
+pub(super) fn morph_glb(base: &Mesh, to: &[P3]) -> Artifact {
+    Artifact {
+        name: "morph.glb".into(),
+        content_type: "model/gltf-binary",
+        bytes: io::write_glb(base.positions(), &base.face_indices(), &[("target".into(), to.to_vec())]),
+    }
 }
 
 /// A planar domain (`uv` per vertex of `disk`) as an OBJ mesh at z = 0.

@@ -3,8 +3,9 @@
 //! three corners on the target's boundary polyline, where it is nearly degenerate and faces
 //! whichever way that polyline turns. A free boundary vertex whose star the evaluator counts
 //! as flipped is tried at the target's boundary vertices (and edge midpoints and quarter
-//! points) strictly between its two boundary neighbours' images, so the boundary's order is
-//! kept and every image stays on the boundary; the best position that lowers the count wins.
+//! points) strictly between its two boundary neighbours' images — alone, then with the next
+//! one or two boundary vertices — so the boundary's order is kept and every image stays on the
+//! boundary; the best placement that lowers the count wins.
 
 use super::visible::evaluator_flips_in_star;
 use crate::map::SurfaceMap;
@@ -14,6 +15,31 @@ use crate::topology;
 
 /// Passes at most.
 const PASSES: usize = 6;
+
+/// Placements tried per move at most.
+const MAX_COMBOS: usize = 4096;
+
+/// Strictly increasing `k`-tuples of `0..n` (positions in order, so the boundary's order is
+/// kept), at most `cap` of them, in lexicographic order.
+fn increasing(n: usize, k: usize, cap: usize) -> Vec<Vec<usize>> {
+    let mut out = Vec::new();
+    let mut cur: Vec<usize> = (0..k).collect();
+    if k == 0 || k > n {
+        return out;
+    }
+    loop {
+        out.push(cur.clone());
+        if out.len() >= cap {
+            return out;
+        }
+        // Advance the last index that can still move.
+        let Some(i) = (0..k).rev().find(|&i| cur[i] < n - k + i) else { return out };
+        cur[i] += 1;
+        for j in i + 1..k {
+            cur[j] = cur[j - 1] + 1;
+        }
+    }
+}
 
 /// Target boundary loops, with where each boundary edge sits (loop, index in loop).
 struct Rings {
@@ -150,11 +176,7 @@ impl State<'_> {
             .collect();
         let cur = self.flips(source, vs);
         let mut best: Option<(usize, Vec<usize>)> = None;
-        let combos: Vec<Vec<usize>> = if vs.len() == 1 {
-            (0..placed.len()).map(|i| vec![i]).collect()
-        } else {
-            (0..placed.len()).flat_map(|i| (i + 1..placed.len()).map(move |j| vec![i, j])).collect()
-        };
+        let combos = increasing(placed.len(), vs.len(), MAX_COMBOS);
         for combo in combos {
             for (v, &k) in vs.iter().zip(&combo) {
                 self.set(*v, placed[k].0, placed[k].1);
@@ -220,7 +242,10 @@ pub fn slide_boundary(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed:
                     continue;
                 }
                 // One vertex between its neighbours; failing that, it and the next one together.
-                if st.improve(source, &[v], a, c) || (!is_fixed[c.idx()] && m > 3 && st.improve(source, &[v, c], a, d))
+                let e = ring[(i + 3) % m];
+                if st.improve(source, &[v], a, c)
+                    || (!is_fixed[c.idx()] && m > 3 && st.improve(source, &[v, c], a, d))
+                    || (!is_fixed[c.idx()] && !is_fixed[d.idx()] && m > 4 && st.improve(source, &[v, c, d], a, e))
                 {
                     moved += 1;
                 }

@@ -76,16 +76,17 @@ fn spec(curves: &[Vec<VertexId>], anchors: Vec<[u64; 2]>) -> JobSpec {
 /// must satisfy; returns the report and the mean ground-truth error over √area.
 fn check(s: &Mesh, t: &Mesh, sp: &JobSpec) -> (MapReport, f64) {
     let (report, arts) = run_map(sp, s, t, &mut NoProgress).unwrap();
-    for n in [
-        "basis_source.json",
-        "basis_target.json",
-        "domain_source.obj",
-        "domain_target.obj",
-        "morph.glb",
-        "metrics.json",
-    ] {
-        assert!(arts.iter().any(|a| a.name == n), "missing {n}");
-    }
+    common::assert_artifacts(
+        &arts,
+        &[
+            "basis_source.json",
+            "basis_target.json",
+            "domain_source.obj",
+            "domain_target.obj",
+            "morph.glb",
+            "metrics.json",
+        ],
+    );
     let glb = arts.iter().find(|a| a.name == "morph.glb").unwrap();
     assert_eq!(&glb.bytes[..4], b"glTF");
     let f = report.features.as_ref().expect("a feature report");

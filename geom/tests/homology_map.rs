@@ -33,21 +33,21 @@ fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, bas
         Err(e) if e.is_input() => return None,
         Err(e) => panic!("{e}"),
     };
-    let names: Vec<&str> = arts.iter().map(|a| a.name.as_str()).collect();
-    for n in [
-        "source_on_target.obj",
-        "target_on_source.obj",
-        "source_to_target.csv",
-        "target_to_source.csv",
-        "basis_source.json",
-        "basis_target.json",
-        "domain_source.obj",
-        "domain_target.obj",
-        "morph.glb",
-        "metrics.json",
-    ] {
-        assert!(names.contains(&n), "missing {n}");
-    }
+    common::assert_artifacts(
+        &arts,
+        &[
+            "source_on_target.obj",
+            "target_on_source.obj",
+            "source_to_target.csv",
+            "target_to_source.csv",
+            "basis_source.json",
+            "basis_target.json",
+            "domain_source.obj",
+            "domain_target.obj",
+            "morph.glb",
+            "metrics.json",
+        ],
+    );
     let mapped = common::source_on_target(&arts, s, t);
     let gt_mean =
         mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(gt[i]))).norm()).sum::<f64>()

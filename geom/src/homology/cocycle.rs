@@ -145,11 +145,16 @@ struct TreeCotree {
 impl TreeCotree {
     /// The edges around dual node `u` (a face, or the cap).
     fn node_edges(&self, mesh: &Mesh, u: usize) -> Vec<EdgeId> {
-        if u == self.nf {
-            self.cap_edges.clone()
-        } else {
-            (0..3).map(|k| mesh.edge(crate::mesh::HalfedgeId::of(crate::mesh::FaceId::from_idx(u), k))).collect()
-        }
+        dual_node_edges(mesh, self.nf, &self.cap_edges, u)
+    }
+}
+
+/// The edges around dual node `u`: face `u`, or the cap (node `nf`, bounded by `cap_edges`).
+fn dual_node_edges(mesh: &Mesh, nf: usize, cap_edges: &[EdgeId], u: usize) -> Vec<EdgeId> {
+    if u == nf {
+        cap_edges.to_vec()
+    } else {
+        (0..3).map(|k| mesh.edge(crate::mesh::HalfedgeId::of(crate::mesh::FaceId::from_idx(u), k))).collect()
     }
 }
 
@@ -206,16 +211,9 @@ fn tree_cotree(mesh: &Mesh, tree_edges: &[EdgeId]) -> Result<TreeCotree> {
     seen[root] = true;
     let mut dq = VecDeque::from([root]);
     let cap_edges: Vec<EdgeId> = loops.first().map(|l| l.iter().map(|&h| mesh.edge(h)).collect()).unwrap_or_default();
-    let node_edges = |u: usize| -> Vec<EdgeId> {
-        if Some(u) == cap {
-            cap_edges.clone()
-        } else {
-            (0..3).map(|k| mesh.edge(crate::mesh::HalfedgeId::of(crate::mesh::FaceId::from_idx(u), k))).collect()
-        }
-    };
     while let Some(u) = dq.pop_front() {
         order.push(u);
-        for e in node_edges(u) {
+        for e in dual_node_edges(mesh, nf, &cap_edges, u) {
             if in_tree[e.idx()] {
                 continue;
             }

@@ -104,3 +104,10 @@ pub fn source_on_target(arts: &[geom::pipeline::Artifact], s: &Mesh, t: &Mesh) -
     assert!(off <= 1e-9 * t.bbox_diagonal(), "off surface {off}");
     mapped
 }
+
+/// Asserts that the job wrote every artifact in `names`.
+pub fn assert_artifacts(arts: &[geom::pipeline::Artifact], names: &[&str]) {
+    for n in names {
+        assert!(arts.iter().any(|a| a.name == *n), "missing {n}");
+    }
+}

@@ -3,13 +3,16 @@
 //! and a vertex of one mesh is carried to the other by locating its triangle coordinates in the
 //! other mesh's embedding of the same patch ([`compose`], [`locate2d`]). [`smooth`] then lowers
 //! the stretch by relocating vertices inside the common domain; [`visible`] and [`slide`] fix what
-//! the shared evaluator would count as folded.
+//! the shared evaluator would count as folded, one vertex at a time; [`untangle`] re-embeds whole
+//! regions around the folds that remain.
 
 pub mod compose;
 pub mod locate2d;
 pub mod patch_param;
+pub mod planar_untangle;
 pub mod slide;
 pub mod smooth;
+pub mod untangle;
 pub mod visible;
 
 pub use compose::compose;

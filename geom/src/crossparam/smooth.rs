@@ -42,6 +42,8 @@ pub struct SmoothReport {
     pub made_visible: usize,
     /// Moves that removed faces the evaluator counts as flipped (`visible::repair_flips`).
     pub repaired: usize,
+    /// Regions around remaining folds re-embedded through a target chart (`untangle`).
+    pub reembedded: usize,
     pub untangled: usize,
     pub moves: usize,
     pub rejected: usize,
@@ -54,6 +56,7 @@ impl SmoothReport {
         SmoothReport {
             made_visible: self.made_visible + o.made_visible,
             repaired: self.repaired + o.repaired,
+            reembedded: self.reembedded + o.reembedded,
             untangled: self.untangled + o.untangled,
             moves: self.moves + o.moves,
             rejected: self.rejected + o.rejected,
@@ -66,13 +69,13 @@ impl SmoothReport {
 /// A source triangle in its own orthonormal frame: `S^-1 = [[a, b], [0, c]]` (the inverse of
 /// the upper-triangular matrix of its edges) and its area.
 #[derive(Debug, Clone, Copy)]
-struct SourceFrame {
+pub(crate) struct SourceFrame {
     inv: [f64; 3],
     area: f64,
 }
 
 impl SourceFrame {
-    fn new(s: [P3; 3]) -> Option<Self> {
+    pub(crate) fn new(s: [P3; 3]) -> Option<Self> {
         let e1 = s[1] - s[0];
         let e2 = s[2] - s[0];
         let l = e1.norm();
@@ -89,7 +92,7 @@ impl SourceFrame {
     /// Symmetric Dirichlet energy of the affine map onto the mapped triangle `m` (scaled by
     /// `scale`), times the source area: `|J|² + |J⁻¹|²` with `J = [m1 - m0, m2 - m0] S⁻¹`
     /// (3x2), so `|J⁻¹|² = |J|² / det(JᵀJ)`. `None` for a degenerate mapped triangle.
-    fn energy(&self, m: [P3; 3], scale: f64) -> Option<f64> {
+    pub(crate) fn energy(&self, m: [P3; 3], scale: f64) -> Option<f64> {
         let [a, b, c] = self.inv;
         let (e1, e2) = ((m[1] - m[0]) * scale, (m[2] - m[0]) * scale);
         let c0 = e1 * a;

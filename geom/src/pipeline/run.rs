@@ -81,13 +81,19 @@ pub(super) fn finish_direction(
     let (mut m, r) = smooth::smooth(from, to, map, fixed, &o.smoothing, progress)?;
     let v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
     let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
+    let untangled = crate::crossparam::untangle::untangle(from, to, &mut m, fixed, &o.untangle)?;
+    let mut v = v;
+    if untangled.regions > 0 {
+        v += crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
+    }
+
     repaired += crate::crossparam::slide::slide_boundary(from, to, &mut m, fixed)?;
     smoothed();
     progress.check()?;
     progress.report("metrics", 0.0);
     let embedded = m.embed(from, to)?;
     let metrics = evaluate_map(from, to, &embedded, Some(anchors), None, &mo)?;
-    Ok((m, smooth::SmoothReport { repaired, made_visible: v, ..r }, embedded, metrics))
+    Ok((m, smooth::SmoothReport { repaired, made_visible: v, reembedded: untangled.regions, ..r }, embedded, metrics))
 }
 
 /// The maps both ways, with what produced them.

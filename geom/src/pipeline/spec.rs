@@ -42,6 +42,8 @@ pub struct MapOptions {
     pub param: PatchParamOptions,
     /// Stretch-reducing relocation of vertices across patch boundaries.
     pub smoothing: SmoothOptions,
+    /// Re-embedding of regions around folds that the one-vertex repairs leave.
+    pub untangle: crate::crossparam::untangle::UntangleOptions,
     /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
     pub metric_samples: usize,
     /// `homology`: basis index (0 = shortest) on the source and on the target.
@@ -69,6 +71,7 @@ impl Default for MapOptions {
             layout: LayoutOptions::default(),
             param: PatchParamOptions::default(),
             smoothing: SmoothOptions::default(),
+            untangle: Default::default(),
             metric_samples: 100_000,
             basis: [0, 0],
             rotation: 0,

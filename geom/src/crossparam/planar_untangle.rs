@@ -12,15 +12,17 @@ pub(crate) fn signed_area(t: [Uv; 3]) -> f64 {
 }
 
 /// Sweeps of [`kernel_sweeps`] at most.
-const KERNEL_SWEEPS: usize = 100;
+const KERNEL_SWEEPS: usize = 30;
 
 /// Moves every free vertex whose star is inverted into the kernel of its 1-ring polygon (the
 /// points that see every ring edge on the chart's side), found by cyclic projection onto the
 /// ring edges' half-planes with a small margin. Returns true when no star is inverted.
 pub(crate) fn kernel_sweeps(m: &Mesh, uv: &mut [Uv], held: &[bool], sign: f64) -> bool {
     let orient = |a: Uv, b: Uv, c: Uv| sign * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]));
+    let mut last = usize::MAX;
+    let mut stalled = 0;
     for _ in 0..KERNEL_SWEEPS {
-        let mut inverted = false;
+        let mut inverted = 0;
         for v in 0..m.n_vertices() {
             if held[v] {
                 continue;
@@ -30,10 +32,10 @@ pub(crate) fn kernel_sweeps(m: &Mesh, uv: &mut [Uv], held: &[bool], sign: f64) -
             if ring.iter().all(|&(a, b)| orient(a, b, uv[v]) > 0.0) {
                 continue;
             }
-            inverted = true;
+            inverted += 1;
             let k = ring.len() as f64;
             let mut p = ring.iter().fold([0.0; 2], |s, (a, _)| [s[0] + a[0] / k, s[1] + a[1] / k]);
-            for _ in 0..64 {
+            for _ in 0..16 {
                 let mut inside = true;
                 for &(a, b) in &ring {
                     let d = [b[0] - a[0], b[1] - a[1]];
@@ -55,8 +57,14 @@ pub(crate) fn kernel_sweeps(m: &Mesh, uv: &mut [Uv], held: &[bool], sign: f64) -
             }
             uv[v] = p;
         }
-        if !inverted {
+        if inverted == 0 {
             return true;
+        }
+        // Stop when the count of inverted stars has not fallen for five sweeps.
+        stalled = if inverted < last { 0 } else { stalled + 1 };
+        last = last.min(inverted);
+        if stalled >= 5 {
+            return false;
         }
     }
     false

@@ -18,6 +18,7 @@
 
 use super::locate2d::Grid;
 use super::planar_untangle::{kernel_sweeps, signed_area, spread_ring, untangle_planar};
+use super::visible::{fold_suspects, unit_normals};
 use crate::error::Result;
 use crate::linalg::{FixedBoundarySystem, Weights};
 use crate::map::SurfaceMap;
@@ -42,7 +43,7 @@ pub struct UntangleOptions {
 
 impl Default for UntangleOptions {
     fn default() -> Self {
-        Self { max_rings: 10, chart_rings: 2, passes: 3, max_attempts: 40 }
+        Self { max_rings: 10, chart_rings: 3, passes: 3, max_attempts: 40 }
     }
 }
 
@@ -292,22 +293,9 @@ pub fn untangle(
     let n = source.n_vertices();
     let pos_of = |map: &SurfaceMap, v: usize| map.position(VertexId::from_idx(v), target);
     let mut pos: Vec<P3> = (0..n).map(|v| pos_of(map, v)).collect();
-    let tn: Vec<V3> = (0..target.n_faces())
-        .map(|f| {
-            let x = target.face_normal_raw(FaceId::from_idx(f));
-            x / x.norm().max(crate::tol::TINY)
-        })
-        .collect();
+    let tn = unit_normals(target);
     // Cheap screen (against the faces the corners lie on), then the evaluator's rule.
-    let suspects: Vec<FaceId> = (0..source.n_faces())
-        .map(FaceId::from_idx)
-        .filter(|&f| {
-            let tri = source.face(f);
-            let m = tri.map(|w| pos[w.idx()]);
-            let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
-            tri.iter().any(|w| nm.dot(&tn[map.face[w.idx()].idx()]) < 0.0)
-        })
-        .collect();
+    let suspects = fold_suspects(source, map, &pos, &tn);
     let mut rep = UntangleResult::default();
     if suspects.is_empty() {
         return Ok(rep);

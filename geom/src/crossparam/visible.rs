@@ -103,6 +103,31 @@ pub(super) fn evaluator_flips_in_star(
         .count()
 }
 
+/// Unit face normals of `mesh`.
+pub(crate) fn unit_normals(mesh: &Mesh) -> Vec<crate::mesh::V3> {
+    (0..mesh.n_faces())
+        .map(|f| {
+            let x = mesh.face_normal_raw(crate::FaceId::from_idx(f));
+            x / x.norm().max(crate::tol::TINY)
+        })
+        .collect()
+}
+
+/// Cheap screen for the evaluator's flip rule: faces of `source` whose image (corners at `pos`)
+/// faces against the target at one corner's own face (`map.face`) at least; `tn` are the
+/// target's unit normals.
+pub(crate) fn fold_suspects(source: &Mesh, map: &SurfaceMap, pos: &[P3], tn: &[crate::mesh::V3]) -> Vec<crate::FaceId> {
+    (0..source.n_faces())
+        .map(crate::FaceId::from_idx)
+        .filter(|&f| {
+            let tri = source.face(f);
+            let m = tri.map(|w| pos[w.idx()]);
+            let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+            tri.iter().any(|w| nm.dot(&tn[map.face[w.idx()].idx()]) < 0.0)
+        })
+        .collect()
+}
+
 /// Passes of [`repair_flips`] at most.
 const REPAIR_PASSES: usize = 8;
 
@@ -120,22 +145,8 @@ const REPAIR_PASSES: usize = 8;
 pub fn repair_flips(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &[VertexId]) -> crate::Result<usize> {
     let n = source.n_vertices();
     let mut pos: Vec<P3> = (0..n).map(|v| map.position(VertexId::from_idx(v), target)).collect();
-    let tn: Vec<crate::mesh::V3> = (0..target.n_faces())
-        .map(|f| {
-            let x = target.face_normal_raw(crate::FaceId::from_idx(f));
-            x / x.norm().max(crate::tol::TINY)
-        })
-        .collect();
-    // Cheap screen: faces against the target at one corner's own face at least.
-    let suspects: Vec<crate::FaceId> = (0..source.n_faces())
-        .map(crate::FaceId::from_idx)
-        .filter(|&f| {
-            let tri = source.face(f);
-            let m = tri.map(|w| pos[w.idx()]);
-            let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
-            tri.iter().any(|w| nm.dot(&tn[map.face[w.idx()].idx()]) < 0.0)
-        })
-        .collect();
+    let tn = unit_normals(target);
+    let suspects = fold_suspects(source, map, &pos, &tn);
     if suspects.is_empty() {
         return Ok(0);
     }

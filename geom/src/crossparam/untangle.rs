@@ -25,6 +25,7 @@ use crate::map::SurfaceMap;
 use crate::mesh::{FaceId, Mesh, P3, V3, VertexId};
 use crate::metrics::SurfaceIndex;
 use crate::param::{BoundaryShape, DiskParamOptions, Uv, disk_boundary, parameterize_disk};
+use crate::topology::SurfacePoint;
 use serde::{Deserialize, Serialize};
 
 /// Options for [`untangle`].
@@ -291,8 +292,7 @@ pub fn untangle(
         return Ok(UntangleResult::default());
     }
     let n = source.n_vertices();
-    let pos_of = |map: &SurfaceMap, v: usize| map.position(VertexId::from_idx(v), target);
-    let mut pos: Vec<P3> = (0..n).map(|v| pos_of(map, v)).collect();
+    let mut pos: Vec<P3> = (0..n).map(|v| map.position(VertexId::from_idx(v), target)).collect();
     let tn = unit_normals(target);
     // Cheap screen (against the faces the corners lie on), then the evaluator's rule.
     let suspects = fold_suspects(source, map, &pos, &tn);
@@ -354,8 +354,7 @@ pub fn untangle(
                 for moved in cands {
                     let (mut p2, mut n2) = (pos.clone(), near.clone());
                     for &(v, tf, b) in &moved {
-                        let [a, bb, c] = target.face_points(tf);
-                        p2[v.idx()] = P3::from(a.coords * b[0] + bb.coords * b[1] + c.coords * b[2]);
+                        p2[v.idx()] = SurfacePoint::Face { face: tf, bary: b }.position(target);
                         n2[v.idx()] = index.query(&p2[v.idx()]).face;
                     }
                     let after = count(&judged, &p2, &n2);

@@ -7,6 +7,7 @@
 //! regions around the folds that remain.
 
 pub mod compose;
+pub mod foldover_free;
 pub mod locate2d;
 pub mod patch_param;
 pub mod planar_untangle;

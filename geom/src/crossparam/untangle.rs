@@ -16,6 +16,7 @@
 //! with the fewest evaluator-counted flips on `R` and the ring around it is kept if that is
 //! fewer than before; otherwise `R` grows by two rings and the step is retried.
 
+use super::foldover_free::{FoldoverFreeOptions, foldover_free};
 use super::locate2d::Grid;
 use super::planar_untangle::{kernel_sweeps, signed_area, spread_ring, untangle_planar};
 use super::visible::{fold_suspects, unit_normals};
@@ -167,6 +168,22 @@ fn fill_holes(mesh: &Mesh, faces: &[FaceId]) -> Vec<FaceId> {
     out
 }
 
+/// For `SURFMAP_DEBUG`: how tangled the current images of a region are in its chart.
+fn chart_state(rmesh: &Mesh, rb: &[VertexId], uv: &[Uv], held: &[bool], sign: f64) -> String {
+    let inv = |f: usize| signed_area(rmesh.face(FaceId::from_idx(f)).map(|v| uv[v.idx()])) * sign <= 0.0;
+    let all_held = |f: usize| rmesh.face(FaceId::from_idx(f)).iter().all(|v| held[v.idx()]);
+    let n_inv = (0..rmesh.n_faces()).filter(|&f| inv(f)).count();
+    let n_inv_held = (0..rmesh.n_faces()).filter(|&f| inv(f) && all_held(f)).count();
+    let area: f64 = (0..rb.len())
+        .map(|i| {
+            let (a, b) = (uv[rb[i].idx()], uv[rb[(i + 1) % rb.len()].idx()]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum::<f64>()
+        / 2.0;
+    format!("inverted {n_inv} (all corners held {n_inv_held}), boundary {} encloses {area:.3e}", rb.len())
+}
+
 /// Re-embeds the source region `faces` inside a chart of the target. Returns candidate new
 /// images of its free interior vertices (parent ids), each a valid embedding in the chart:
 /// the current images with inverted stars moved into their kernels (the least change), the
@@ -229,6 +246,9 @@ fn reembed(
         why("image outside the chart");
         return Vec::new();
     };
+    if std::env::var_os("SURFMAP_DEBUG").is_some() {
+        why(&chart_state(&rmesh, &rb, &current, &is_held, sign));
+    }
     let held_vs: Vec<VertexId> = (0..rmesh.n_vertices()).map(VertexId::from_idx).filter(|v| is_held[v.idx()]).collect();
     let tutte = FixedBoundarySystem::new(&rmesh, &held_vs)
         .ok()
@@ -248,10 +268,16 @@ fn reembed(
                 }
             }
             let init = uv.clone();
-            let ok = kernel_sweeps(&rmesh, &mut uv, &held, sign) || {
-                uv.clone_from(&init);
-                untangle_planar(&rmesh, &mut uv, &held, sign)
-            };
+            let ok = kernel_sweeps(&rmesh, &mut uv, &held, sign)
+                || {
+                    uv.clone_from(&init);
+                    untangle_planar(&rmesh, &mut uv, &held, sign)
+                }
+                // The global untangler (the costliest) last.
+                || {
+                    uv.clone_from(&init);
+                    foldover_free(&rmesh, &mut uv, &held, sign, &FoldoverFreeOptions::default()).valid
+                };
             if !ok {
                 why(if spread { "no valid embedding (rings spread)" } else { "no valid embedding" });
                 continue;
@@ -333,12 +359,15 @@ pub fn untangle(
         faces.iter().filter(|&&f| folded(source, &tn, &index, f, pos, near)).count()
     };
     let mut attempts = 0;
+    // Seeds whose every region size failed are not tried again in later passes.
+    let mut hopeless: std::collections::HashSet<FaceId> = std::collections::HashSet::new();
     for _ in 0..opts.passes {
         let mut progress = false;
         for &f in &folds.clone() {
-            if !folded(source, &tn, &index, f, &pos, &near) {
+            if hopeless.contains(&f) || !folded(source, &tn, &index, f, &pos, &near) {
                 continue;
             }
+            let mut fixed_here = false;
             for rings in (2..=opts.max_rings).step_by(2) {
                 if attempts >= opts.max_attempts {
                     break;
@@ -380,8 +409,12 @@ pub fn untangle(
                     near = c.near;
                     rep.regions += 1;
                     progress = true;
+                    fixed_here = true;
                     break;
                 }
+            }
+            if !fixed_here && attempts < opts.max_attempts {
+                hopeless.insert(f);
             }
         }
         // Re-embedding can leave a fold beside the one it removed: look everywhere again.

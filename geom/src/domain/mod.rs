@@ -79,6 +79,9 @@ pub struct LayoutOptions {
     pub straighten_rounds: usize,
     /// Path flipping after the layout is built, before straightening.
     pub flip: flip::FlipOptions,
+    /// When a `voronoi` layout cannot be completed after every rebuild, build the greedy
+    /// baseline's layout instead of failing (reported in `LayoutStats::fallback`).
+    pub greedy_fallback: bool,
 }
 
 impl Default for LayoutOptions {
@@ -89,6 +92,7 @@ impl Default for LayoutOptions {
             rebuilds: 3,
             straighten_rounds: 1,
             flip: Default::default(),
+            greedy_fallback: true,
         }
     }
 }
@@ -110,6 +114,9 @@ pub struct LayoutStats {
     pub straightened: usize,
     /// Paths flipped (the same on both meshes).
     pub flipped: usize,
+    /// The path choice used instead of the requested one (`"greedy"`), if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<String>,
 }
 
 /// Patches from the walks of a layout: its triangular walks (all of them once the layout is

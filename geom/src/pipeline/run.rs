@@ -128,10 +128,13 @@ pub fn run_map(
     // the requested density is rebuilt at higher ones before giving up.
     let mut edge_nodes = o.layout.edge_nodes;
     let mut attempt = 0;
+    // A `voronoi` layout that cannot be completed at any density falls back to the greedy
+    // baseline's path choice (reported as `layout.fallback`), unless the options forbid it.
+    let mut method = spec.method;
     let (st, tt, stats) = loop {
         let (st, tt) = both(|| Tracer::new(target, &ta, &edge_nodes), || Tracer::new(source, &sa, &edge_nodes))?;
         let (mut st, mut tt) = (st?, tt?);
-        let built = match spec.method {
+        let built = match method {
             Method::Voronoi => voronoi::source_layout(&mut st, chi, &o.layout, progress).and_then(|(cl, mut s)| {
                 let t = voronoi::target_layout_with_restarts(&st, &cl, &mut tt, &o.layout, 8, progress)?;
                 s.postponed = t.postponed;
@@ -145,7 +148,18 @@ pub fn run_map(
             Ok(mut s) => {
                 s.rebuilds = attempt;
                 s.edge_nodes_min = edge_nodes.min_nodes;
+                s.fallback = (method != spec.method).then(|| "greedy".to_string());
                 break (st, tt, s);
+            }
+            Err(Error::Input(InputError::LayoutConflict(m)))
+                if attempt >= o.layout.rebuilds && method == Method::Voronoi && o.layout.greedy_fallback =>
+            {
+                if std::env::var_os("SURFMAP_DEBUG").is_some() {
+                    eprintln!("greedy fallback after: {m}");
+                }
+                method = Method::Greedy;
+                edge_nodes = o.layout.edge_nodes;
+                attempt = 0;
             }
             Err(Error::Input(InputError::LayoutConflict(m))) if attempt < o.layout.rebuilds => {
                 if std::env::var_os("SURFMAP_DEBUG").is_some() {

@@ -1,0 +1,38 @@
+//! Method `homology` between different shapes of genus 2 (`eight.off` ↔ the cup): two
+//! homotopy classes, told apart by their induced maps on H1, each map with 0 flipped faces both
+//! ways (the shared evaluator's rule, which `metrics` reproduces) and the base anchors exact.
+
+use geom::mesh::Mesh;
+use geom::pipeline::{JobSpec, MapOptions, MapReport, Method, run_map};
+use geom::progress::NoProgress;
+
+mod common;
+use common::load;
+
+fn run(s: &Mesh, t: &Mesh, basis: [usize; 2], rotation: usize) -> MapReport {
+    let spec = JobSpec {
+        method: Method::Homology,
+        features: Vec::new(),
+        anchors: vec![[0, 0]],
+        options: MapOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
+    };
+    run_map(&spec, s, t, &mut NoProgress).unwrap().0
+}
+
+#[test]
+fn eight_to_cup_in_two_homotopy_classes_without_flips() {
+    let s = load("eight.off");
+    let t = load("cup_input_simple_10000.off");
+    let mut h1s = Vec::new();
+    for basis in [[2, 0], [2, 2]] {
+        let r = run(&s, &t, basis, 0);
+        for m in [&r.source_to_target, &r.target_to_source] {
+            assert_eq!(m.flipped_faces, 0, "basis {basis:?}: {m:?}");
+            assert!(m.anchor_error_max.unwrap() <= 1e-9, "basis {basis:?}: {m:?}");
+            assert!(m.off_surface_max <= 1e-9, "basis {basis:?}: {m:?}");
+        }
+        let h = r.homology.unwrap();
+        h1s.push(h.h1_reference.unwrap_or(h.h1));
+    }
+    assert_ne!(h1s[0], h1s[1], "two different classes");
+}

@@ -11,8 +11,10 @@
 //! onto the target. This is the "local re-parameterization" remedy for folds of Schreiner et
 //! al. 2004 and Kraevoy & Sheffer 2004, section 5. Since `R`'s boundary polygon need not be
 //! convex, the current images and the Tutte embedding are both repaired in the plane
-//! ([`super::planar_untangle`]), with and without the anchors' rings spread as in the source,
-//! and a candidate counts only if every face of `R` keeps the chart's orientation. The candidate
+//! ([`super::planar_untangle`]; [`super::foldover_free`] for tangles the local moves cannot
+//! free, and as a lower-distortion variant of their result), with and without the anchors'
+//! rings spread as in the source, and a candidate counts only if every face of `R` keeps the
+//! chart's orientation. The candidate
 //! with the fewest evaluator-counted flips on `R` and the ring around it is kept if that is
 //! fewer than before; otherwise `R` grows by two rings and the step is retried.
 
@@ -188,7 +190,7 @@ fn chart_state(rmesh: &Mesh, rb: &[VertexId], uv: &[Uv], held: &[bool], sign: f6
 /// images of its free interior vertices (parent ids), each a valid embedding in the chart:
 /// the current images with inverted stars moved into their kernels (the least change), the
 /// Tutte embedding with the same repair, and either with the rings of held interior vertices
-/// spread. Empty when none is valid.
+/// spread; each also minimized by the foldover-free energy. Empty when none is valid.
 fn reembed(
     source: &Mesh,
     target: &Mesh,
@@ -268,35 +270,42 @@ fn reembed(
                 }
             }
             let init = uv.clone();
-            let ok = kernel_sweeps(&rmesh, &mut uv, &held, sign)
-                || {
-                    uv.clone_from(&init);
-                    untangle_planar(&rmesh, &mut uv, &held, sign)
-                }
-                // The global untangler (the costliest) last.
-                || {
-                    uv.clone_from(&init);
-                    foldover_free(&rmesh, &mut uv, &held, sign, &FoldoverFreeOptions::default()).valid
-                };
-            if !ok {
+            let local = kernel_sweeps(&rmesh, &mut uv, &held, sign) || {
+                uv.clone_from(&init);
+                untangle_planar(&rmesh, &mut uv, &held, sign)
+            };
+            let mut sols = Vec::new();
+            if local {
+                sols.push(uv.clone());
+            } else {
+                uv.clone_from(&init);
+            }
+            // The global untangler (the costliest): from the tangle when the local moves fail,
+            // else from their valid result, as a lower-distortion second candidate (a valid chart
+            // embedding can still lift to a face the evaluator counts as flipped across a crease).
+            if foldover_free(&rmesh, &mut uv, &held, sign, &FoldoverFreeOptions::default()).valid {
+                sols.push(uv);
+            }
+            if sols.is_empty() {
                 why(if spread { "no valid embedding (rings spread)" } else { "no valid embedding" });
-                continue;
             }
-            // Every face of R must keep the chart's orientation.
-            if !(0..rmesh.n_faces())
-                .all(|f| signed_area(rmesh.face(FaceId::from_idx(f)).map(|v| uv[v.idx()])) * sign > 0.0)
-            {
-                continue;
+            for uv in sols {
+                // Every face of R must keep the chart's orientation.
+                if !(0..rmesh.n_faces())
+                    .all(|f| signed_area(rmesh.face(FaceId::from_idx(f)).map(|v| uv[v.idx()])) * sign > 0.0)
+                {
+                    continue;
+                }
+                out.push(
+                    (0..rmesh.n_vertices())
+                        .filter(|&v| !is_held[v])
+                        .map(|v| {
+                            let (lf, b) = grid.locate(&chart.uv, &dtris, uv[v]);
+                            (rparent[v], dfaces[lf as usize], b)
+                        })
+                        .collect(),
+                );
             }
-            out.push(
-                (0..rmesh.n_vertices())
-                    .filter(|&v| !is_held[v])
-                    .map(|v| {
-                        let (lf, b) = grid.locate(&chart.uv, &dtris, uv[v]);
-                        (rparent[v], dfaces[lf as usize], b)
-                    })
-                    .collect(),
-            );
         }
     }
     out

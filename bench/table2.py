@@ -214,7 +214,9 @@ def main():
                     print(f"| {name} | {nv} | {len(a)} | {method} | — | — | — | — | — | — | — | — | {e['error']} |")
                     continue
                 gtm = f"{e['gt_error_mean']:.4f}" if "gt_error_mean" in e else "—"
-                print(f"| {name} | {nv} | {len(a)} | {method} | {e['time']:.2f} | {e['patches']} | "
+                fb = e["report"].get("layout", {}).get("fallback")
+                shown = f"{method} ({fb} layout)" if fb else method
+                print(f"| {name} | {nv} | {len(a)} | {shown} | {e['time']:.2f} | {e['patches']} | "
                       f"{e['angle_distortion']:.3f} | {e['l2_stretch']:.4f} | {e['flipped_faces']}/{e['rev_flips']} | "
                       f"{e['area_ratio']:.4f} | {e['off_surface_max']:.1e} | {e['anchor_error_max']:.1e} | {gtm} |",
                       flush=True)

@@ -16,6 +16,8 @@ use argmin::core::{CostFunction, Error as ArgminError, Executor, Gradient};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
 use argmin::solver::quasinewton::LBFGS;
 
+use super::planar_untangle::signed_area;
+use super::smooth::SourceFrame;
 use crate::mesh::{FaceId, Mesh};
 use crate::param::Uv;
 
@@ -31,13 +33,11 @@ pub struct FoldoverFreeOptions {
     /// Rounds without a 1% gain in the smallest determinant, while it is negative, before
     /// giving up.
     pub stall_rounds: usize,
-    /// Rounds after the first valid one, to lower the distortion.
-    pub polish_rounds: usize,
 }
 
 impl Default for FoldoverFreeOptions {
     fn default() -> Self {
-        Self { rounds: 40, iterations: 150, theta: 1.0 / 128.0, stall_rounds: 6, polish_rounds: 40 }
+        Self { rounds: 40, iterations: 150, theta: 1.0 / 128.0, stall_rounds: 6 }
     }
 }
 
@@ -219,20 +219,12 @@ pub fn foldover_free(
     let mut chart_area = 0.0;
     for f in 0..m.n_faces() {
         let c = m.face(FaceId::from_idx(f));
-        let [a, b, d] = c.map(|v| m.position(v));
-        let (e1, e2) = (b - a, d - a);
-        let l1 = e1.norm();
-        let (px, py) = (e1.dot(&e2) / l1.max(f64::MIN_POSITIVE), e1.cross(&e2).norm() / l1.max(f64::MIN_POSITIVE));
-        let det = l1 * py;
-        if det.is_nan() || det <= 0.0 || !det.is_finite() {
+        let Some(frame) = SourceFrame::new(m.face_points(FaceId::from_idx(f))) else {
             return FoldoverFreeResult::default();
-        }
-        // Inverse of [[l1, px], [0, py]].
-        let r = [[1.0 / l1, -px / det], [0.0, 1.0 / py]];
-        ref_area += det / 2.0;
-        let p = c.map(|v| fixed[v.idx()]);
-        chart_area += super::planar_untangle::signed_area(p) / 2.0;
-        tris.push((c.map(|v| v.0), r, det / 2.0));
+        };
+        ref_area += frame.area();
+        chart_area += signed_area(c.map(|v| fixed[v.idx()])) / 2.0;
+        tris.push((c.map(|v| v.0), frame.inverse(), frame.area()));
     }
     if chart_area.is_nan() || chart_area <= 0.0 {
         return FoldoverFreeResult::default();
@@ -248,8 +240,7 @@ pub fn foldover_free(
     }
     // A triangle with every corner held cannot be repaired.
     if tris.iter().any(|(c, _, _)| {
-        c.iter().all(|&v| var[v as usize] == u32::MAX)
-            && super::planar_untangle::signed_area(c.map(|v| fixed[v as usize])) <= 0.0
+        c.iter().all(|&v| var[v as usize] == u32::MAX) && signed_area(c.map(|v| fixed[v as usize])) <= 0.0
     }) {
         return FoldoverFreeResult::default();
     }
@@ -257,7 +248,7 @@ pub fn foldover_free(
     let md = prob.min_det(&x);
     prob.eps = if md > 0.0 { 1e-9 } else { (1e-12 + 0.04 * md * md).sqrt() };
     let mut res = FoldoverFreeResult { min_det: md, ..Default::default() };
-    let (mut best, mut stalled, mut valid_rounds) = (md, 0, 0);
+    let (mut best, mut stalled) = (md, 0);
     for round in 0..opts.rounds {
         res.rounds = round + 1;
         let e_prev = prob.eval(&x, None);
@@ -275,12 +266,9 @@ pub fn foldover_free(
         res.min_det = md;
         let mu = (1.0 - sigma) * chi(md, prob.eps);
         prob.eps = if md < mu { 2.0 * (mu * (mu - md)).max(0.0).sqrt() } else { 1e-10 };
-        // Valid: keep lowering the energy (at the small ε that follows) for a few rounds.
-        if md > 0.0 && (valid_rounds >= opts.polish_rounds || (e_prev - e).abs() <= 1e-5 * e.abs()) {
+        // Valid: keep lowering the energy (at the small ε that follows) until it settles.
+        if md > 0.0 && (e_prev - e).abs() <= 1e-5 * e.abs() {
             break;
-        }
-        if md > 0.0 {
-            valid_rounds += 1;
         }
         // Give up on a tangle whose worst triangle stops improving while still inverted.
         if md <= 0.0 {
@@ -360,9 +348,7 @@ mod tests {
         }
         let inverted = |uv: &[Uv]| {
             (0..m.n_faces())
-                .filter(|&f| {
-                    super::super::planar_untangle::signed_area(m.face(FaceId::from_idx(f)).map(|v| uv[v.idx()])) <= 0.0
-                })
+                .filter(|&f| super::signed_area(m.face(FaceId::from_idx(f)).map(|v| uv[v.idx()])) <= 0.0)
                 .count()
         };
         assert!(inverted(&uv) >= 10, "the test must start tangled: {}", inverted(&uv));

@@ -89,6 +89,16 @@ impl SourceFrame {
         Some(Self { inv: [1.0 / l, -e2x / (l * e2y), 1.0 / e2y], area: 0.5 * nn })
     }
 
+    /// `S⁻¹` as a 2x2 matrix (rows), for maps into the plane.
+    pub(crate) fn inverse(&self) -> [[f64; 2]; 2] {
+        let [a, b, c] = self.inv;
+        [[a, b], [0.0, c]]
+    }
+
+    pub(crate) fn area(&self) -> f64 {
+        self.area
+    }
+
     /// Symmetric Dirichlet energy of the affine map onto the mapped triangle `m` (scaled by
     /// `scale`), times the source area: `|J|² + |J⁻¹|²` with `J = [m1 - m0, m2 - m0] S⁻¹`
     /// (3x2), so `|J⁻¹|² = |J|² / det(JᵀJ)`. `None` for a degenerate mapped triangle.

@@ -21,7 +21,7 @@
 use super::foldover_free::{FoldoverFreeOptions, foldover_free};
 use super::locate2d::Grid;
 use super::planar_untangle::{kernel_sweeps, signed_area, spread_ring, untangle_planar};
-use super::visible::{fold_suspects, unit_normals};
+use super::visible::{evaluator_folded, fold_suspects, unit_normals};
 use crate::error::Result;
 use crate::linalg::{FixedBoundarySystem, Weights};
 use crate::map::SurfaceMap;
@@ -77,12 +77,7 @@ struct Candidate {
 /// `near`: the image faces against the target at its corners' faces and its centroid's.
 fn folded(source: &Mesh, tn: &[V3], index: &SurfaceIndex, f: FaceId, pos: &[P3], near: &[FaceId]) -> bool {
     let tri = source.face(f);
-    let m = tri.map(|w| pos[w.idx()]);
-    let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
-    if tri.iter().any(|w| nm.dot(&tn[near[w.idx()].idx()]) >= 0.0) {
-        return false;
-    }
-    nm.dot(&tn[index.query(&crate::metrics::face_centroid(m)).face.idx()]) < 0.0
+    evaluator_folded(tri.map(|w| pos[w.idx()]), tri.map(|w| near[w.idx()]), tn, index)
 }
 
 /// Faces within `rings` vertex-rings of `seed`.

@@ -94,13 +94,23 @@ pub(super) fn evaluator_flips_in_star(
         .filter(|&f| {
             let tri = source.face(f);
             let m = tri.map(|w| if w == v { p } else { pos[w.idx()] });
-            let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
-            let c = crate::metrics::face_centroid(m);
-            let mut under = tri.map(|w| if w == v { pf } else { near[w.idx()] }).to_vec();
-            under.push(index.query(&c).face);
-            under.iter().all(|g| nm.dot(&tn[g.idx()]) < 0.0)
+            evaluator_folded(m, tri.map(|w| if w == v { pf } else { near[w.idx()] }), tn, index)
         })
         .count()
+}
+
+/// The evaluator's flip rule for one mapped triangle `m` whose corners lie on target faces
+/// `under`: its normal opposes the target's at those three faces and at the face nearest to its
+/// centroid (queried last, only when the corners agree).
+pub(crate) fn evaluator_folded(
+    m: [P3; 3],
+    under: [crate::FaceId; 3],
+    tn: &[crate::mesh::V3],
+    index: &SurfaceIndex,
+) -> bool {
+    let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
+    under.iter().all(|g| nm.dot(&tn[g.idx()]) < 0.0)
+        && nm.dot(&tn[index.query(&crate::metrics::face_centroid(m)).face.idx()]) < 0.0
 }
 
 /// Unit face normals of `mesh`.

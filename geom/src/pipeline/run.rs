@@ -79,14 +79,12 @@ pub(super) fn finish_direction(
 ) -> Result<(SurfaceMap, smooth::SmoothReport, Mesh, MapMetrics)> {
     let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
     let (mut m, r) = smooth::smooth(from, to, map, fixed, &o.smoothing, progress)?;
-    let v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
+    let mut v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
     let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
     let untangled = crate::crossparam::untangle::untangle(from, to, &mut m, fixed, &o.untangle)?;
-    let mut v = v;
     if untangled.regions > 0 {
         v += crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
     }
-
     repaired += crate::crossparam::slide::slide_boundary(from, to, &mut m, fixed)?;
     smoothed();
     progress.check()?;

@@ -136,6 +136,44 @@ fn a_face_maps_onto_itself_exactly() {
     assert!(gt < 1e-9, "gt {gt}");
 }
 
+/// The meta-mesh of feature jobs: both cut disks overlaid in the circle (each boundary refined
+/// by the other's points) and sewn along every cut: one face list, every input vertex a
+/// meta-vertex, the surfaces' χ, every vertex on its own surface. Same shape (hand bent, four
+/// features and the wrist) and different shapes (face ↔ hand, pruned at 10°).
+#[test]
+fn feature_jobs_build_the_meta_mesh() {
+    let s = load("hand_lowres.obj");
+    let t = bent(&s);
+    let mut sp = spec(&features(&s, 4), vec![]);
+    sp.options.meta_mesh = true;
+    let (r, arts) = run_map(&sp, &s, &t, &mut NoProgress).unwrap();
+    let stats = r.features.as_ref().unwrap().meta_mesh.clone().expect("meta-mesh statistics");
+    assert!(stats.error.is_none() && stats.crossings > 0, "{stats:?}");
+    common::meta_pair(&arts, &s, &t, "hand bent", false);
+
+    let (a, b) = (load("face.off"), load("hand_lowres.obj"));
+    let raw = |p: &Vec<VertexId>| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
+    let sp = JobSpec {
+        method: Method::Homology,
+        anchors: vec![],
+        features: features(&a, 4)
+            .iter()
+            .zip(&features(&b, 4))
+            .map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) })
+            .collect(),
+        options: MapOptions {
+            metric_samples: 5000,
+            meta_mesh: true,
+            dihedral_threshold_deg: Some(10.0),
+            ..Default::default()
+        },
+    };
+    let (r, arts) = run_map(&sp, &a, &b, &mut NoProgress).unwrap();
+    let stats = r.features.as_ref().unwrap().meta_mesh.clone().expect("meta-mesh statistics");
+    assert!(stats.error.is_none() && stats.pruned_vertices.is_some_and(|p| p > 0), "{stats:?}");
+    common::meta_pair(&arts, &a, &b, "face / hand, pruned at 10°", true);
+}
+
 #[test]
 fn bad_curves_and_unsupported_topologies_are_refused() {
     let s = load("face.off");

@@ -2,11 +2,9 @@
 //! homotopy classes (rotations τ, basis choices) the true one maps with 0 flips, exact anchors
 //! and a small ground-truth error; other rotations give other H1 matrices.
 
-use geom::io::ReadOptions;
 use geom::mesh::{Mesh, VertexId};
 use geom::pipeline::{JobSpec, MapOptions, MapReport, Method, run_map};
 use geom::progress::NoProgress;
-use geom::topology::Locator;
 
 mod common;
 use common::{bent, load, shuffled};
@@ -157,21 +155,7 @@ fn check_meta(s: &Mesh, t: &Mesh, anchors: &[[u64; 2]], what: &str, prune: Optio
     let stats = report.homology.as_ref().unwrap().meta_mesh.clone().unwrap();
     assert!(stats.error.is_none(), "{what}: {stats:?}");
     assert_eq!(stats.pruned_vertices.is_some(), prune.is_some());
-    let get = |n: &str| {
-        let a = arts.iter().find(|a| a.name == n).unwrap_or_else(|| panic!("{what}: missing {n}"));
-        geom::io::read(&a.bytes, &ReadOptions::default()).unwrap().mesh
-    };
-    let (ms, mt) = (get("meta_source.obj"), get("meta_target.obj"));
-    assert_eq!(ms.faces(), mt.faces(), "{what}: shared faces");
-    if prune.is_none() {
-        assert!(ms.n_vertices() >= s.n_vertices().max(t.n_vertices()), "{what}: {} meta vertices", ms.n_vertices());
-    }
-    assert_eq!(geom::topology::euler_characteristic(&ms), geom::topology::euler_characteristic(s), "{what}: χ");
-    for (m, surf) in [(&ms, s), (&mt, t)] {
-        let loc = Locator::new(surf).unwrap();
-        let off = m.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
-        assert!(off <= 1e-9 * surf.bbox_diagonal(), "{what}: off surface {off}");
-    }
+    let (ms, _) = common::meta_pair(&arts, s, t, what, prune.is_some());
     ms.n_faces()
 }
 

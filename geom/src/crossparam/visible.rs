@@ -23,9 +23,12 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
         is_fixed[v.idx()] = true;
     }
     let mut pos: Vec<P3> = (0..n).map(|v| map.position(VertexId::from_idx(v), target)).collect();
+    // Which images the rule does not see, screened at once (in parallel, Morton order): a
+    // vertex's test reads only its own image, which no earlier move changes.
+    let dist = index.distances(&pos);
     let mut moved = 0;
     for vi in 0..n {
-        if is_fixed[vi] || index.query(&pos[vi]).distance <= tol {
+        if is_fixed[vi] || dist[vi] <= tol {
             continue;
         }
         let f = map.face[vi];

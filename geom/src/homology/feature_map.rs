@@ -100,7 +100,7 @@ pub fn feature_map(
 }
 
 /// Angle of a point of the circle in `[0, 2π)`.
-fn angle(p: [f64; 2]) -> f64 {
+pub(crate) fn angle(p: [f64; 2]) -> f64 {
     let a = p[1].atan2(p[0]);
     if a < 0.0 { a + std::f64::consts::TAU } else { a }
 }

@@ -28,6 +28,7 @@ pub mod domain;
 pub mod feature_cut;
 pub mod feature_domain;
 pub mod feature_map;
+pub mod feature_overlay;
 pub mod features;
 pub mod map;
 pub mod matching;

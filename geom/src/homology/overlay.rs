@@ -1,5 +1,6 @@
 //! The meta-mesh (Carner et al. section 4, after Lee et al. 1999): both tessellations overlaid
-//! in the shared 4g-gon. Every source triangle is clipped against the target triangles it
+//! in the shared planar domain (the 4g-gon, or the circle of a feature job, see
+//! [`super::feature_overlay`]). Every source triangle is clipped against the target triangles it
 //! overlaps (Sutherland–Hodgman, convex against convex); each non-empty piece is a convex
 //! polygon whose corners are source vertices, target vertices or crossings of a source edge with
 //! a target edge, named symbolically so that neighbouring pieces share them. Pieces are fanned
@@ -42,13 +43,37 @@ impl MetaMeshResult {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-enum Key {
-    /// A vertex of the source / target refinement (copies across a cut are one vertex).
+/// A surface vertex a disk vertex stands for: of the source or of the target (copies across a
+/// cut are one vertex).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub(crate) enum VKey {
     S(u32),
     T(u32),
-    /// Source edge (refined vertex pair) crossing target edge.
-    X([u32; 2], [u32; 2]),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Key {
+    V(VKey),
+    /// Source edge (its ends' keys) crossing target edge.
+    X([VKey; 2], [VKey; 2]),
+}
+
+/// One side of an overlay: a planar triangulated disk (positions on this side's surface), the
+/// planar position and the key of each of its vertices.
+pub(crate) struct OverlayDisk<'a> {
+    pub mesh: &'a Mesh,
+    pub uv: &'a [Uv],
+    pub key: Vec<VKey>,
+}
+
+/// The surfaces the keys index, and keys that are one meta-vertex: `(target key, source key)`
+/// pairs of points the two domains share (the homology base vertex, feature junctions).
+pub(crate) struct OverlayInput<'a> {
+    pub source: OverlayDisk<'a>,
+    pub target: OverlayDisk<'a>,
+    pub source_surface: &'a Mesh,
+    pub target_surface: &'a Mesh,
+    pub same: Vec<(VKey, VKey)>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -87,12 +112,30 @@ fn cross(a: Uv, b: Uv, c: Uv) -> f64 {
 /// # Errors
 /// `Numerical` when a piece cannot be placed.
 pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshResult> {
-    let (ds, dt) = (&s.basis.disk, &t.basis.disk);
     let (ca, sa) = (angle.cos(), angle.sin());
     let us: Vec<Uv> = s.domain.uv.iter().map(|p| [p[0] * ca - p[1] * sa, p[0] * sa + p[1] * ca]).collect();
-    let ut = &t.domain.uv;
+    let (ds, dt) = (&s.basis.disk, &t.basis.disk);
+    overlay(&OverlayInput {
+        source: OverlayDisk { mesh: &ds.mesh, uv: &us, key: ds.orig.iter().map(|v| VKey::S(v.0)).collect() },
+        target: OverlayDisk { mesh: &dt.mesh, uv: &t.domain.uv, key: dt.orig.iter().map(|v| VKey::T(v.0)).collect() },
+        source_surface: &s.basis.refined.mesh,
+        target_surface: &t.basis.refined.mesh,
+        // The base vertex is a corner of both polygons: one meta-vertex.
+        same: vec![(VKey::T(t.basis.base.0), VKey::S(s.basis.base.0))],
+    })
+}
+
+/// Overlays two planar disks that tile the same region.
+///
+/// # Errors
+/// `Numerical` when a piece cannot be placed.
+pub(crate) fn overlay(input: &OverlayInput) -> Result<MetaMeshResult> {
+    let (ds, dt) = (&input.source, &input.target);
+    let us = ds.uv;
+    let ut = dt.uv;
     let tt = dt.mesh.face_indices();
     let st = ds.mesh.face_indices();
+    let alias: HashMap<VKey, VKey> = input.same.iter().copied().collect();
     // Bucket grid over target triangles.
     let n = tt.len().max(1);
     let cells = (n as f64).sqrt().ceil() as usize;
@@ -109,9 +152,9 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
         }
     }
     let eps = 1e-12;
-    let so = |v: u32| ds.orig[v as usize].0;
-    let to = |v: u32| dt.orig[v as usize].0;
-    let pair = |a: u32, b: u32| if a < b { [a, b] } else { [b, a] };
+    let so = |v: u32| ds.key[v as usize];
+    let to = |v: u32| dt.key[v as usize];
+    let pair = |a: VKey, b: VKey| if a < b { [a, b] } else { [b, a] };
     let mut ids: HashMap<Key, u32> = HashMap::new();
     let mut on_source: Vec<P3> = Vec::new();
     let mut on_target: Vec<P3> = Vec::new();
@@ -143,7 +186,7 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
                     let mut poly: Vec<PV> = (0..3)
                         .map(|k| PV {
                             p: sp[k],
-                            key: Key::S(so(stri[k])),
+                            key: Key::V(so(stri[k])),
                             next: Support::Src(stri[k], stri[(k + 1) % 3]),
                         })
                         .collect();
@@ -175,7 +218,7 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
                                     Support::Tgt(x, y) => {
                                         // Two target edges meet at their shared vertex.
                                         let shared = [x, y].into_iter().find(|&v| v == te.0 || v == te.1);
-                                        shared.map_or(Key::T(to(te.0)), |v| Key::T(to(v)))
+                                        shared.map_or(Key::V(to(te.0)), |v| Key::V(to(v)))
                                     }
                                     Support::Src(x, y) => {
                                         // Along the target edge: snap to its ends.
@@ -183,9 +226,9 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
                                             + (ip[1] - qa[1]) * (qb[1] - qa[1]))
                                             / (len * len);
                                         if tl <= eps {
-                                            Key::T(to(te.0))
+                                            Key::V(to(te.0))
                                         } else if tl >= 1.0 - eps {
-                                            Key::T(to(te.1))
+                                            Key::V(to(te.1))
                                         } else if u <= eps {
                                             a.key
                                         } else if u >= 1.0 - eps {
@@ -219,12 +262,14 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
                     let mut vid = Vec::with_capacity(poly.len());
                     for pv in &poly {
                         let next_id = on_source.len() as u32;
-                        // The base vertex is a corner of both polygons: one meta-vertex.
-                        let key = if pv.key == Key::T(t.basis.base.0) { Key::S(s.basis.base.0) } else { pv.key };
+                        let key = match pv.key {
+                            Key::V(k) => Key::V(alias.get(&k).copied().unwrap_or(k)),
+                            x => x,
+                        };
                         let id = *ids.entry(key).or_insert(next_id);
                         if id == next_id {
-                            let ps = point(&ds.mesh, *stri, bary(sp, pv.p));
-                            let pt = point(&dt.mesh, ttri, bary(tp, pv.p));
+                            let ps = point(ds.mesh, *stri, bary(sp, pv.p));
+                            let pt = point(dt.mesh, ttri, bary(tp, pv.p));
                             on_source.push(ps);
                             on_target.push(pt);
                             crossing.push(matches!(key, Key::X(..)));
@@ -243,16 +288,19 @@ pub fn meta_mesh(s: &SideDomain, t: &SideDomain, angle: f64) -> Result<MetaMeshR
             }
         }
     }
-    // Exact positions where the meta-vertex is an input vertex.
+    // Exact positions where the meta-vertex is an input vertex (on both surfaces where it is a
+    // shared point).
+    let (ms, mt) = (input.source_surface, input.target_surface);
     for (key, &id) in &ids {
         match key {
-            Key::S(v) if *v == s.basis.base.0 => {
-                on_source[id as usize] = s.basis.refined.mesh.position(VertexId(*v));
-                on_target[id as usize] = t.basis.refined.mesh.position(t.basis.base);
-            }
-            Key::S(v) => on_source[id as usize] = s.basis.refined.mesh.position(VertexId(*v)),
-            Key::T(v) => on_target[id as usize] = t.basis.refined.mesh.position(VertexId(*v)),
+            Key::V(VKey::S(v)) => on_source[id as usize] = ms.position(VertexId(*v)),
+            Key::V(VKey::T(v)) => on_target[id as usize] = mt.position(VertexId(*v)),
             Key::X(..) => {}
+        }
+    }
+    for &(tk, sk) in &input.same {
+        if let (Some(&id), VKey::T(v)) = (ids.get(&Key::V(sk)), tk) {
+            on_target[id as usize] = mt.position(VertexId(v));
         }
     }
     Ok(MetaMeshResult { faces, on_source, on_target, crossings, crossing })

@@ -136,7 +136,7 @@ fn share_edge(a: [u32; 3], b: [u32; 3]) -> bool {
     a.iter().filter(|x| b.contains(x)).count() == 2
 }
 
-/// Whether collapsing `u` into `v` keeps a manifold and keeps every moved face within `theta`
+/// Whether collapsing `u` (not on the boundary) into `v` keeps a manifold and keeps every moved face within `theta`
 /// of where it was, unfolded and not flat, on both surfaces.
 fn collapsible(
     u: u32,
@@ -156,6 +156,11 @@ fn collapsible(
         r
     };
     let (ru, rv) = (ring(u), ring(v));
+    // A vertex on the boundary (an open fan: one more neighbour than faces) stays: collapsing it
+    // along an interior edge would pinch the surface, and the boundary keeps its shape.
+    if ru.len() != fs.len() {
+        return false;
+    }
     let common = ru.iter().filter(|w| rv.binary_search(w).is_ok()).count();
     let across = fs.iter().filter(|t| t.contains(&v)).count();
     if across != 2 || common != 2 || ru.len() <= 3 || rv.len() <= 3 {

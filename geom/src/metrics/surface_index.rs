@@ -122,6 +122,11 @@ impl<'m> SurfaceIndex<'m> {
         out
     }
 
+    /// The distances of [`SurfaceIndex::query`] for every point, searched in Morton order.
+    pub fn distances(&self, pts: &[P3]) -> Vec<f64> {
+        self.distances_in_order(pts, &super::distance::morton_order(pts))
+    }
+
     /// [`SurfaceIndex::query`] for every point (face and point included, ties resolved in the
     /// candidates' distance order as the evaluator does), visited in Morton order.
     pub fn query_all(&self, pts: &[P3]) -> Vec<Nearest> {

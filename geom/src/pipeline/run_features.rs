@@ -4,7 +4,9 @@
 
 use super::artifacts;
 use super::run::{Artifact, Clock, MapReport};
-use super::run_homology::{finish_pair, finish_report, json_artifact, morph_glb, pair_report, planar_obj};
+use super::run_homology::{
+    finish_pair, finish_report, json_artifact, meta_outputs, morph_glb, pair_report, planar_obj,
+};
 use super::spec::JobSpec;
 use crate::error::Result;
 use crate::homology::feature_cut::{FeatureCutResult, Side, SideKind};
@@ -35,6 +37,9 @@ pub struct FeatureReport {
     pub anchor_warp: bool,
     /// Flipped triangles in the two planar domains (0: both maps bijective).
     pub domain_flips: [usize; 2],
+    /// Meta-mesh vertices, faces and edge crossings, when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub meta_mesh: Option<super::run_homology::MetaMeshStats>,
 }
 
 /// Runs a feature job (called by `run_homology` when the spec has features or the meshes have
@@ -70,7 +75,7 @@ pub(super) fn run_features(
     clock.lap("smooth_metrics");
     progress.check()?;
     let (sc, tc) = (&r.source.cut.curves, &r.target.cut.curves);
-    let report_f = FeatureReport {
+    let mut report_f = FeatureReport {
         curves: sc.len(),
         order: r.order.clone(),
         kinds: sc.iter().map(|c| c.kind).collect(),
@@ -79,9 +84,20 @@ pub(super) fn run_features(
         feature_error: [feature_error(&f.s2t, target, sc, tc), feature_error(&f.t2s, source, tc, sc)],
         anchor_warp: r.warped,
         domain_flips: [r.source.domain.injectivity.flipped, r.target.domain.injectivity.flipped],
+        meta_mesh: None,
     };
     let mut arts = artifacts::maps_and_meshes(&f.s2t, &f.t2s, &f.on_target, &f.on_source);
-    arts.push(morph_glb(source, f.on_target.positions()));
+    let mut morph = None;
+    if o.meta_mesh {
+        progress.report("meta_mesh", 0.0);
+        let m = crate::homology::feature_overlay::feature_meta_mesh(&r.source, &r.target, source, target)?;
+        let (stats, m) = meta_outputs(m, o, &mut arts)?;
+        report_f.meta_mesh = Some(stats);
+        morph = m;
+        clock.lap("meta_mesh");
+    }
+    // The morph: the meta-mesh pair when there is one, else the source to its image.
+    arts.push(morph.unwrap_or_else(|| morph_glb(source, f.on_target.positions())));
     arts.push(json_artifact("basis_source.json", &cut_json(&r.source, source))?);
     arts.push(json_artifact("basis_target.json", &cut_json(&r.target, target))?);
     arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });

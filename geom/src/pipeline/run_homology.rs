@@ -61,6 +61,51 @@ pub struct MetaMeshStats {
     pub error: Option<String>,
 }
 
+/// The meta-mesh pair's artifacts (`meta_source.obj`, `meta_target.obj`), pruned below
+/// `dihedral_threshold_deg` when set; its statistics, and the morph from one to the other.
+/// A meta-mesh that is not a valid mesh is reported in the statistics, not raised.
+///
+/// # Errors
+/// As [`prune_meta_mesh`].
+pub(super) fn meta_outputs(
+    mut m: crate::homology::overlay::MetaMeshResult,
+    o: &MapOptions,
+    arts: &mut Vec<Artifact>,
+) -> Result<(MetaMeshStats, Option<Artifact>)> {
+    let mut pruned = None;
+    if let Some(deg) = o.dihedral_threshold_deg {
+        let p = prune_meta_mesh(&m, &PruneOptions { dihedral_threshold_deg: deg })?;
+        pruned = Some(p.removed_vertices);
+        m = p.mesh;
+    }
+    let mut stats = MetaMeshStats {
+        vertices: m.on_source.len(),
+        faces: m.faces.len(),
+        crossings: m.crossings,
+        pruned_vertices: pruned,
+        error: None,
+    };
+    match m.meshes() {
+        Ok((ms, mt)) => {
+            arts.push(Artifact {
+                name: "meta_source.obj".into(),
+                content_type: "model/obj",
+                bytes: io::write(&ms, Format::Obj),
+            });
+            arts.push(Artifact {
+                name: "meta_target.obj".into(),
+                content_type: "model/obj",
+                bytes: io::write(&mt, Format::Obj),
+            });
+            Ok((stats, Some(morph_glb(&ms, mt.positions()))))
+        }
+        Err(e) => {
+            stats.error = Some(e.to_string());
+            Ok((stats, None))
+        }
+    }
+}
+
 /// Runs a `homology` job.
 ///
 /// # Errors
@@ -133,37 +178,9 @@ pub fn run_homology(
     if o.meta_mesh {
         progress.report("meta_mesh", 0.0);
         let angle = std::f64::consts::TAU * r.side_shift as f64 / (4 * g) as f64;
-        let mut m = crate::homology::overlay::meta_mesh(&r.source, &r.target, angle)?;
-        let mut pruned = None;
-        if let Some(deg) = o.dihedral_threshold_deg {
-            let p = prune_meta_mesh(&m, &PruneOptions { dihedral_threshold_deg: deg })?;
-            pruned = Some(p.removed_vertices);
-            m = p.mesh;
-        }
-        let mut stats = MetaMeshStats {
-            vertices: m.on_source.len(),
-            faces: m.faces.len(),
-            crossings: m.crossings,
-            pruned_vertices: pruned,
-            error: None,
-        };
-        match m.meshes() {
-            Ok((ms, mt)) => {
-                arts.push(Artifact {
-                    name: "meta_source.obj".into(),
-                    content_type: "model/obj",
-                    bytes: io::write(&ms, Format::Obj),
-                });
-                arts.push(Artifact {
-                    name: "meta_target.obj".into(),
-                    content_type: "model/obj",
-                    bytes: io::write(&mt, Format::Obj),
-                });
-                morph = Some(morph_glb(&ms, mt.positions()));
-            }
-            Err(e) => stats.error = Some(e.to_string()),
-        }
+        let (stats, m) = meta_outputs(crate::homology::overlay::meta_mesh(&r.source, &r.target, angle)?, o, &mut arts)?;
         meta = Some(stats);
+        morph = m;
         clock.lap("meta_mesh");
     }
     let report_h = HomologyReport {

@@ -111,3 +111,25 @@ pub fn assert_artifacts(arts: &[geom::pipeline::Artifact], names: &[&str]) {
         assert!(arts.iter().any(|a| a.name == *n), "missing {n}");
     }
 }
+
+/// The job's meta-mesh pair, checked: one face list, at least as many vertices as either input
+/// (every input vertex is a meta-vertex), the inputs' Euler characteristic, and every vertex on
+/// its own surface (within 1e-9 of its diagonal, exact projection).
+pub fn meta_pair(arts: &[geom::pipeline::Artifact], s: &Mesh, t: &Mesh, what: &str, pruned: bool) -> (Mesh, Mesh) {
+    let get = |n: &str| {
+        let a = arts.iter().find(|a| a.name == n).unwrap_or_else(|| panic!("{what}: missing {n}"));
+        geom::io::read(&a.bytes, &ReadOptions::default()).unwrap().mesh
+    };
+    let (ms, mt) = (get("meta_source.obj"), get("meta_target.obj"));
+    assert_eq!(ms.faces(), mt.faces(), "{what}: shared faces");
+    if !pruned {
+        assert!(ms.n_vertices() >= s.n_vertices().max(t.n_vertices()), "{what}: {} meta vertices", ms.n_vertices());
+    }
+    assert_eq!(geom::topology::euler_characteristic(&ms), geom::topology::euler_characteristic(s), "{what}: χ");
+    for (m, surf) in [(&ms, s), (&mt, t)] {
+        let loc = geom::topology::Locator::new(surf).unwrap();
+        let off = m.positions().iter().map(|p| loc.project(p).distance).fold(0.0, f64::max);
+        assert!(off <= 1e-9 * surf.bbox_diagonal(), "{what}: off surface {off}");
+    }
+    (ms, mt)
+}

@@ -2,7 +2,10 @@
 """Method `homology` with feature curves and boundary loops (genus 0), judged by
 ../shared/eval/meshmetrics.py: same-shape cases (known correspondence) and different shapes.
 
-usage: [FEATURES=k] python3 bench/homology_features.py [path/to/surfmap] [filter]
+usage: [FEATURES=k] [META=1] python3 bench/homology_features.py [path/to/surfmap] [filter]
+
+META=1 also builds the meta-mesh (`meta_mesh: true`) and prints, per case, its vertices, faces and
+edge crossings and the milliseconds of the meta-mesh stage.
 
 Features are built on each mesh: k centres by farthest-point sampling among interior vertices at
 least two rings from the boundary, each a shortest edge path of about 6% of the bounding-box
@@ -88,6 +91,8 @@ def features(V, F, k):
 def run(binary, tmp, s, t, feats, anchors, gt):
     spec = {"method": "homology", "anchors": anchors,
             "features": [{"source": [int(x) for x in a], "target": [int(x) for x in b]} for a, b in feats]}
+    if os.environ.get("META"):
+        spec["options"] = {"meta_mesh": True}
     e = table2.run(binary, tmp, "", s, t, anchors or None, gt, "homology", spec=spec, repeats=1)
     if "error" not in e:
         e["features"] = e["report"]["features"]
@@ -136,6 +141,11 @@ def main():
             print(f"| {name} | {nv} | {len(feats)} | {e['time']:.2f} | {e['angle_distortion']:.3f} | {e['l2_stretch']:.4f} | "
                   f"{e['flipped_faces']}/{e['rev_flips']} | {e['area_ratio']:.4f} | {e['off_surface_max']:.1e} | "
                   f"{max(fe):.1e} | {gtm} | {e['features']['word']} |", flush=True)
+            meta = e["features"].get("meta_mesh")
+            if meta:
+                ms = dict(e["report"]["timings_ms"]).get("meta_mesh", float("nan"))
+                print(f"|   meta-mesh | {meta['vertices']} vertices, {meta['faces']} faces, {meta['crossings']} crossings, "
+                      f"{ms:.0f} ms {meta.get('error') or ''} |", flush=True)
             if os.environ.get("DUMP"):
                 json.dump(e["report"], sys.stderr, indent=1)
 

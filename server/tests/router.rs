@@ -211,14 +211,15 @@ async fn homology_job_through_the_queue() {
     for n in ["basis_source.json", "domain_target.obj", "meta_source.obj", "meta_target.obj", "metrics.json"] {
         assert!(names.contains(&n), "{n} missing from {names:?}");
     }
-    // A disk with a feature curve (and its boundary as a feature): mapped exactly.
+    // A disk with a feature curve (and its boundary as a feature): mapped exactly, with the
+    // meta-mesh of the two circle domains.
     let g = geom::mesh::shapes::grid(8);
     let gt =
         g.with_positions(g.positions().iter().map(|p| geom::mesh::P3::new(p.x * 1.5, p.y, 0.3 * p.x * p.y)).collect());
     let (_, a) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&g, Format::Off))).await;
     let (_, b) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&gt.unwrap(), Format::Off))).await;
     let spec = json!({"method": "homology", "anchors": [[0, 0]],
-        "features": [{"source": [40, 41, 42], "target": [40, 41, 42]}]});
+        "features": [{"source": [40, 41, 42], "target": [40, 41, 42]}], "options": {"meta_mesh": true}});
     let body = json!({"source": a["id"], "target": b["id"], "spec": spec}).to_string();
     let req = Request::post("/v1/jobs").header("content-type", "application/json").body(Body::from(body)).unwrap();
     let (st, _, job) = call(&t, req).await;
@@ -230,6 +231,12 @@ async fn homology_job_through_the_queue() {
     assert_eq!(f["curves"], 2, "{done}");
     assert!(f["feature_error"][0].as_f64().unwrap() <= 1e-9, "{done}");
     assert_eq!(done["result"]["source_to_target"]["flipped_faces"], 0, "{done}");
+    assert!(f["meta_mesh"]["faces"].as_u64().unwrap() >= 128 && f["meta_mesh"]["error"].is_null(), "{done}");
+    let (_, list) = json_call(&t, "GET", &format!("/v1/jobs/{id}/artifacts"), Body::empty()).await;
+    let names: Vec<&str> = list["artifacts"].as_array().unwrap().iter().filter_map(|a| a["name"].as_str()).collect();
+    for n in ["meta_source.obj", "meta_target.obj", "morph.glb"] {
+        assert!(names.contains(&n), "{n} missing from {names:?}");
+    }
     // Genus 0 has no homology basis: refused before queueing.
     let (sp, _) = sphere_pair();
     let (_, c) = json_call(&t, "POST", "/v1/meshes", Body::from(sp)).await;

@@ -90,8 +90,8 @@ pub(super) fn run_features(
     let mut morph = None;
     if o.meta_mesh {
         progress.report("meta_mesh", 0.0);
-        let m = crate::homology::feature_overlay::feature_meta_mesh(&r.source, &r.target, source, target)?;
-        let (stats, m) = meta_outputs(m, o, &mut arts)?;
+        let m = crate::homology::feature_overlay::feature_meta_mesh(&r.source, &r.target, source, target);
+        let (stats, m) = meta_outputs(m, o, &mut arts);
         report_f.meta_mesh = Some(stats);
         morph = m;
         clock.lap("meta_mesh");

@@ -63,22 +63,33 @@ pub struct MetaMeshStats {
 
 /// The meta-mesh pair's artifacts (`meta_source.obj`, `meta_target.obj`), pruned below
 /// `dihedral_threshold_deg` when set; its statistics, and the morph from one to the other.
-/// A meta-mesh that is not a valid mesh is reported in the statistics, not raised.
-///
-/// # Errors
-/// As [`prune_meta_mesh`].
+/// The meta-mesh is an extra: a merge, pruning or validation that fails is reported in the
+/// statistics (`error`, no meta artifacts), and the maps still succeed.
 pub(super) fn meta_outputs(
-    mut m: crate::homology::overlay::MetaMeshResult,
+    built: Result<crate::homology::overlay::MetaMeshResult>,
     o: &MapOptions,
     arts: &mut Vec<Artifact>,
-) -> Result<(MetaMeshStats, Option<Artifact>)> {
+) -> (MetaMeshStats, Option<Artifact>) {
+    let failed = |e: Error| {
+        let stats =
+            MetaMeshStats { vertices: 0, faces: 0, crossings: 0, pruned_vertices: None, error: Some(e.to_string()) };
+        (stats, None)
+    };
+    let mut m = match built {
+        Ok(m) => m,
+        Err(e) => return failed(e),
+    };
     let mut pruned = None;
     if let Some(deg) = o.dihedral_threshold_deg {
-        let p = prune_meta_mesh(&m, &PruneOptions { dihedral_threshold_deg: deg })?;
-        pruned = Some(p.removed_vertices);
-        m = p.mesh;
+        match prune_meta_mesh(&m, &PruneOptions { dihedral_threshold_deg: deg }) {
+            Ok(p) => {
+                pruned = Some(p.removed_vertices);
+                m = p.mesh;
+            }
+            Err(e) => return failed(e),
+        }
     }
-    let mut stats = MetaMeshStats {
+    let stats = MetaMeshStats {
         vertices: m.on_source.len(),
         faces: m.faces.len(),
         crossings: m.crossings,
@@ -97,12 +108,9 @@ pub(super) fn meta_outputs(
                 content_type: "model/obj",
                 bytes: io::write(&mt, Format::Obj),
             });
-            Ok((stats, Some(morph_glb(&ms, mt.positions()))))
+            (stats, Some(morph_glb(&ms, mt.positions())))
         }
-        Err(e) => {
-            stats.error = Some(e.to_string());
-            Ok((stats, None))
-        }
+        Err(e) => (MetaMeshStats { error: Some(e.to_string()), ..stats }, None),
     }
 }
 
@@ -178,7 +186,7 @@ pub fn run_homology(
     if o.meta_mesh {
         progress.report("meta_mesh", 0.0);
         let angle = std::f64::consts::TAU * r.side_shift as f64 / (4 * g) as f64;
-        let (stats, m) = meta_outputs(crate::homology::overlay::meta_mesh(&r.source, &r.target, angle)?, o, &mut arts)?;
+        let (stats, m) = meta_outputs(crate::homology::overlay::meta_mesh(&r.source, &r.target, angle), o, &mut arts);
         meta = Some(stats);
         morph = m;
         clock.lap("meta_mesh");

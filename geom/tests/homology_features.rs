@@ -63,11 +63,19 @@ fn features(m: &Mesh, k: usize) -> Vec<Vec<VertexId>> {
 }
 
 fn spec(curves: &[Vec<VertexId>], anchors: Vec<[u64; 2]>) -> JobSpec {
+    spec_pairs(curves.iter().zip(curves), anchors)
+}
+
+/// A job with curve pairs (source, target) on two different meshes.
+fn spec_pairs<'a>(
+    pairs: impl Iterator<Item = (&'a Vec<VertexId>, &'a Vec<VertexId>)>,
+    anchors: Vec<[u64; 2]>,
+) -> JobSpec {
     let raw = |p: &Vec<VertexId>| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
     JobSpec {
         method: Method::Homology,
         anchors,
-        features: curves.iter().map(|p| FeatureSpec { source: raw(p), target: raw(p) }).collect(),
+        features: pairs.map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) }).collect(),
         options: MapOptions { metric_samples: 5000, ..Default::default() },
     }
 }
@@ -152,22 +160,10 @@ fn feature_jobs_build_the_meta_mesh() {
     common::meta_pair(&arts, &s, &t, "hand bent", false);
 
     let (a, b) = (load("face.off"), load("hand_lowres.obj"));
-    let raw = |p: &Vec<VertexId>| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
-    let sp = JobSpec {
-        method: Method::Homology,
-        anchors: vec![],
-        features: features(&a, 4)
-            .iter()
-            .zip(&features(&b, 4))
-            .map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) })
-            .collect(),
-        options: MapOptions {
-            metric_samples: 5000,
-            meta_mesh: true,
-            dihedral_threshold_deg: Some(10.0),
-            ..Default::default()
-        },
-    };
+    let (ca, cb) = (features(&a, 4), features(&b, 4));
+    let mut sp = spec_pairs(ca.iter().zip(&cb), vec![]);
+    sp.options.meta_mesh = true;
+    sp.options.dihedral_threshold_deg = Some(10.0);
     let (r, arts) = run_map(&sp, &a, &b, &mut NoProgress).unwrap();
     let stats = r.features.as_ref().unwrap().meta_mesh.clone().expect("meta-mesh statistics");
     assert!(stats.error.is_none() && stats.pruned_vertices.is_some_and(|p| p > 0), "{stats:?}");

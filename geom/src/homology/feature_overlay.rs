@@ -53,12 +53,16 @@ fn same_point(w: &[(f64, VKey, Uv)], a: f64) -> Option<usize> {
     (!w.is_empty() && (a - tau).abs() <= SAME_ANGLE && w[0].0 == 0.0).then_some(0)
 }
 
-/// `own`'s disk with every point of `other` (not shared with `own`) inserted into the boundary
-/// edge whose angles enclose it.
-fn refine(own: &FeatureSide, own_key: fn(u32) -> VKey, other: &[(f64, VKey, Uv)]) -> Result<RefinedDisk> {
+/// `own`'s disk (its walk `mine`) with every point of `other` (not shared with `own`) inserted
+/// into the boundary edge whose angles enclose it.
+fn refine(
+    own: &FeatureSide,
+    own_key: fn(u32) -> VKey,
+    mine: &[(f64, VKey, Uv)],
+    other: &[(f64, VKey, Uv)],
+) -> Result<RefinedDisk> {
     let tau = std::f64::consts::TAU;
     let disk = &own.cut.disk.mesh;
-    let mine = walk(own, own_key);
     let mut pos: Vec<P3> = disk.positions().to_vec();
     let mut uv = own.domain.uv.clone();
     let mut key: Vec<VKey> = own.cut.disk.orig.iter().map(|v| own_key(v.0)).collect();
@@ -145,7 +149,7 @@ pub fn feature_meta_mesh(s: &FeatureSide, t: &FeatureSide, source: &Mesh, target
     }
     same.sort();
     same.dedup();
-    let (rs, rt) = (refine(s, VKey::S, &wt_rest)?, refine(t, VKey::T, &ws_rest)?);
+    let (rs, rt) = (refine(s, VKey::S, &ws, &wt_rest)?, refine(t, VKey::T, &wt, &ws_rest)?);
     overlay(&OverlayInput {
         source: OverlayDisk { mesh: &rs.mesh, uv: &rs.uv, key: rs.key },
         target: OverlayDisk { mesh: &rt.mesh, uv: &rt.uv, key: rt.key },

@@ -136,8 +136,8 @@ fn share_edge(a: [u32; 3], b: [u32; 3]) -> bool {
     a.iter().filter(|x| b.contains(x)).count() == 2
 }
 
-/// Whether collapsing `u` (not on the boundary) into `v` keeps a manifold and keeps every moved face within `theta`
-/// of where it was, unfolded and not flat, on both surfaces.
+/// Whether collapsing `u` (not on the boundary) into `v` keeps a manifold and keeps every moved
+/// face within `theta` of where it was, unfolded and not flat, on both surfaces.
 fn collapsible(
     u: u32,
     v: u32,

@@ -1,7 +1,8 @@
 //! The planar domain of a feature cut: the disk mapped onto the unit circle with mean-value
-//! weights (Floater 2003), side `k` on the arc `[θ_k, θ_{k+1}]` by arc length. Both meshes of a
+//! weights (Floater 2003), side `k` on the arc `[θ_k, θ_{k+1}]`. Both meshes of a
 //! pair use the same arcs, so the two domains share their boundary and their composition is a
-//! bijection that takes every feature onto its partner.
+//! bijection that takes every feature onto its partner. The vertices of a side sit at given
+//! fractions of its arc: arc length, or the warp of [`super::curve_align`].
 //!
 //! A circle instead of the paper's regular polygon: the boundary vertices are then in strictly
 //! convex position, so Floater's theorem holds even where an edge joins two boundary vertices
@@ -43,15 +44,27 @@ pub fn shared_arcs(a: &FeatureCutResult, b: &FeatureCutResult) -> Result<Vec<f64
     Ok(sa.iter().zip(&sb).map(|(x, y)| 0.5 * (x + y)).collect())
 }
 
-/// Maps the cut disk onto the unit circle with the given arcs.
+/// Maps the cut disk onto the unit circle with the given arcs, the vertices of side `k` at
+/// `fractions[k]` of its arc ([`super::curve_align::arc_fractions`], or a warp of them;
+/// strictly increasing in `[0, 1)`).
 ///
 /// # Errors
 /// `Numerical` when the solve fails or the map folds.
-pub fn feature_domain(cut: &FeatureCutResult, arcs: &[f64], stretch_iterations: usize) -> Result<FeatureDomainResult> {
+pub fn feature_domain(
+    cut: &FeatureCutResult,
+    arcs: &[f64],
+    fractions: &[Vec<f64>],
+    stretch_iterations: usize,
+) -> Result<FeatureDomainResult> {
     let disk = &cut.disk.mesh;
     let walk = &cut.walk;
-    if arcs.len() != cut.sides.len() {
-        return Err(Error::Internal(format!("{} arcs for {} sides", arcs.len(), cut.sides.len())));
+    if arcs.len() != cut.sides.len() || fractions.len() != cut.sides.len() {
+        return Err(Error::Internal(format!(
+            "{} arcs and {} fraction lists for {} sides",
+            arcs.len(),
+            fractions.len(),
+            cut.sides.len()
+        )));
     }
     let tau = std::f64::consts::TAU;
     let mut angles = Vec::with_capacity(arcs.len());
@@ -63,12 +76,12 @@ pub fn feature_domain(cut: &FeatureCutResult, arcs: &[f64], stretch_iterations: 
     let mut fixed = vec![[f64::NAN; 2]; disk.n_vertices()];
     for (k, s) in cut.sides.iter().enumerate() {
         let end = if k + 1 < angles.len() { angles[k + 1] } else { tau };
-        let mut t = 0.0;
-        for i in 0..s.edges {
-            let (v, w) = (walk[(s.start + i) % walk.len()], walk[(s.start + i + 1) % walk.len()]);
-            let th = angles[k] + (end - angles[k]) * t / s.length.max(f64::MIN_POSITIVE);
-            fixed[v.idx()] = [th.cos(), th.sin()];
-            t += (disk.position(w) - disk.position(v)).norm();
+        if fractions[k].len() != s.edges {
+            return Err(Error::Internal(format!("side {k}: {} fractions for {} edges", fractions[k].len(), s.edges)));
+        }
+        for (i, t) in fractions[k].iter().enumerate() {
+            let th = angles[k] + (end - angles[k]) * t;
+            fixed[walk[(s.start + i) % walk.len()].idx()] = [th.cos(), th.sin()];
         }
     }
     let (uv, residual) = solve_disk(disk, walk, &fixed, stretch_iterations)?;

@@ -4,6 +4,7 @@
 //! are the same arc of the circle), and the composition of two bijections is one.
 
 use super::compose::{Planar, locate_all, warp_interior};
+use super::curve_align::{CurveAlignOptions, align_fractions, arc_fractions};
 use super::feature_cut::{FeatureCutResult, chain_order, feature_cut};
 use super::feature_domain::{FeatureDomainResult, feature_domain, shared_arcs};
 use super::features::{Curve, CurveKind};
@@ -24,6 +25,16 @@ impl FeatureSide {
     }
 }
 
+/// How the two domains are built.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FeatureMapOptions {
+    /// Stretch-reweighting rounds of each domain (0 = the plain mean-value map).
+    pub stretch_iterations: usize,
+    /// Align the target's curve sides to the source's vertex by vertex
+    /// ([`super::curve_align`]); `None` places both by arc length.
+    pub align: Option<CurveAlignOptions>,
+}
+
 /// Maps both ways and what produced them.
 #[derive(Debug, Clone)]
 pub struct FeatureMapResult {
@@ -37,8 +48,7 @@ pub struct FeatureMapResult {
     pub order: Vec<(usize, bool)>,
 }
 
-/// Maps `source` onto `target` so that `source_curves[i]` lands on `target_curves[i]`; each
-/// domain gets `stretch_iterations` stretch-reweighting rounds.
+/// Maps `source` onto `target` so that `source_curves[i]` lands on `target_curves[i]`.
 /// A boundary anchor pair fixes where an unlisted boundary loop starts; otherwise an interior
 /// anchor pair starts the chain when that loop is the only curve.
 ///
@@ -51,7 +61,7 @@ pub fn feature_map(
     source_curves: &[Curve],
     target_curves: &[Curve],
     anchors: &[(VertexId, VertexId)],
-    stretch_iterations: usize,
+    o: &FeatureMapOptions,
 ) -> Result<FeatureMapResult> {
     if source_curves.len() != target_curves.len() {
         return Err(InputError::Features(format!(
@@ -83,8 +93,12 @@ pub fn feature_map(
     let sc = sc?;
     let tc = tc.map_err(|_| crate::Error::Internal("feature cut thread panicked".into()))??;
     let arcs = shared_arcs(&sc, &tc)?;
-    let it = stretch_iterations;
-    let (sd, td) = (feature_domain(&sc, &arcs, it)?, feature_domain(&tc, &arcs, it)?);
+    let it = o.stretch_iterations;
+    let tf = match &o.align {
+        Some(a) => align_fractions(&sc, &tc, a),
+        None => arc_fractions(&tc),
+    };
+    let (sd, td) = (feature_domain(&sc, &arcs, &arc_fractions(&sc), it)?, feature_domain(&tc, &arcs, &tf, it)?);
     let mut s = FeatureSide { cut: sc, domain: sd };
     let t = FeatureSide { cut: tc, domain: td };
     let id = |p| p;
@@ -107,9 +121,9 @@ pub(crate) fn angle(p: [f64; 2]) -> f64 {
 
 /// Places every vertex whose disk copy lies on the circle exactly on the other disk's boundary
 /// polygon, by angle: the point between the two boundary vertices whose angles enclose it, at
-/// the fraction of the angle (angles grow linearly with arc length within a side on both
-/// disks, and side ends share their angles, so junctions land on junctions and every curve
-/// vertex on its partner curve). A grid search would clamp such points into whichever
+/// the fraction of the angle (angles increase along every side on both disks, and side ends
+/// share their angles, so junctions land on junctions, every curve vertex on its partner curve,
+/// and a vertex aligned with a partner vertex exactly on it). A grid search would clamp such points into whichever
 /// triangle is least outside, which need not be the one on the chord.
 ///
 /// # Errors
@@ -230,7 +244,7 @@ mod tests {
         let pos: Vec<P3> = s.positions().iter().map(|p| P3::new(1.6 * p.x, p.y + 0.2 * p.x * p.x, 0.8 * p.z)).collect();
         let t = s.with_positions(pos).unwrap();
         let c = sphere_curves(&s);
-        let r = feature_map(&s, &t, &c, &c, &[], 0).unwrap();
+        let r = feature_map(&s, &t, &c, &c, &[], &FeatureMapOptions::default()).unwrap();
         for side in [&r.source, &r.target] {
             assert!(side.domain.injectivity.is_injective());
             assert!(side.domain.residual < 1e-9, "residual {}", side.domain.residual);

@@ -172,7 +172,7 @@ mod tests {
     #[test]
     fn squares_of_different_resolution_overlay_into_one_disk() {
         let (a, b) = (shapes::grid(5), shapes::grid(7));
-        let r = feature_map(&a, &b, &[], &[], &[(VertexId(0), VertexId(0))], 0).unwrap();
+        let r = feature_map(&a, &b, &[], &[], &[(VertexId(0), VertexId(0))], &Default::default()).unwrap();
         let m = feature_meta_mesh(&r.source, &r.target, &a, &b).unwrap();
         let (ms, mt) = m.meshes().unwrap();
         assert_eq!(ms.faces(), mt.faces());

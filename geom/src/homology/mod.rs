@@ -23,6 +23,7 @@ pub mod basis;
 pub mod classes;
 pub mod cocycle;
 pub mod compose;
+pub mod curve_align;
 pub mod cut;
 pub mod domain;
 pub mod feature_cut;

@@ -9,8 +9,9 @@ use super::run_homology::{
 };
 use super::spec::JobSpec;
 use crate::error::Result;
+use crate::homology::curve_align::CurveAlignOptions;
 use crate::homology::feature_cut::{FeatureCutResult, Side, SideKind};
-use crate::homology::feature_map::{FeatureSide, feature_error, feature_map};
+use crate::homology::feature_map::{FeatureMapOptions, FeatureSide, feature_error, feature_map};
 use crate::homology::features::{Curve, CurveKind};
 use crate::mesh::{Mesh, VertexId};
 use crate::progress::Progress;
@@ -59,7 +60,11 @@ pub(super) fn run_features(
     let o = &spec.options;
     clock.lap("setup");
     progress.report("feature_cut", 0.0);
-    let r = feature_map(source, target, curves.0, curves.1, pairs, o.domain_stretch_iterations)?;
+    let fo = FeatureMapOptions {
+        stretch_iterations: o.domain_stretch_iterations,
+        align: o.align_curves.then(CurveAlignOptions::default),
+    };
+    let r = feature_map(source, target, curves.0, curves.1, pairs, &fo)?;
     clock.lap("cut_domain_map");
     progress.check()?;
     // Open curves and the chain's junctions stay put; boundary vertices between junctions may

@@ -56,6 +56,10 @@ pub struct MapOptions {
     /// planar domain (0 = the plain mean-value map). Spreads protrusions that the harmonic map
     /// crushes (a hand cut at the wrist) at the price of more folds between different shapes.
     pub domain_stretch_iterations: usize,
+    /// `homology` with feature curves or boundaries: align the target's curves to the source's
+    /// vertex by vertex (dynamic time warping of arc length and boundary angle) instead of
+    /// placing both by arc length alone.
+    pub align_curves: bool,
     /// `homology` with `meta_mesh`: prune the meta-mesh, keeping only edges whose dihedral
     /// angle exceeds this many degrees on either surface (flat vertices are collapsed).
     pub dihedral_threshold_deg: Option<f64>,
@@ -77,6 +81,7 @@ impl Default for MapOptions {
             rotation: 0,
             meta_mesh: false,
             domain_stretch_iterations: 0,
+            align_curves: true,
             dihedral_threshold_deg: None,
             matching: None,
         }

@@ -1,0 +1,223 @@
+//! Vertex-level alignment of the curve sides of two feature cuts, by dynamic time warping.
+//!
+//! [`feature_domain`](super::feature_domain) places each side's vertices on its arc by arc
+//! length, on both meshes. Two copies of one boundary that differ by a non-isometric
+//! deformation then disagree by a few vertex spacings, and on a zigzag boundary that is enough
+//! to send a source triangle whose three corners are boundary vertices onto a chord of the
+//! target boundary that turns the other way (a flipped face). Here the target's positions along
+//! each curve side are warped so that its vertices land where the source's corresponding
+//! vertices do.
+//!
+//! Technique: dynamic time warping (Sakoe–Chiba 1978) of the two sides' vertex sequences, with
+//! a cost per pair that adds the squared difference of their arc-length fractions (scaled by a
+//! band, so the warp stays near the arc-length correspondence) and the squared difference of
+//! their interior angles on the disk (the boundary's turning within the surface: a zigzag's
+//! tips and notches), and a penalty per unmatched step. The pairs matched one to one (diagonal
+//! steps) are the warp's knots; target vertices between knots are spread by arc length. Links
+//! (the chain's own cuts) are left to arc length: they are drawn separately on each mesh.
+
+use super::feature_cut::{FeatureCutResult, SideKind};
+
+/// How the warp weighs its terms.
+#[derive(Debug, Clone, Copy)]
+pub struct CurveAlignOptions {
+    /// Arc-length fraction of a side over which a shift costs as much as a half-turn of angle
+    /// mismatch.
+    pub band: f64,
+    /// Cost of a step that matches one vertex with two.
+    pub gap: f64,
+    /// Largest `(n + 1)(m + 1)` aligned; longer sides keep arc length.
+    pub max_cells: usize,
+    /// Angles compared on each side of a vertex (a window of `2 w + 1`).
+    pub window: usize,
+}
+
+impl Default for CurveAlignOptions {
+    fn default() -> Self {
+        Self { band: 0.2, gap: 0.1, max_cells: 16_000_000, window: 2 }
+    }
+}
+
+/// Per side, the fraction in `[0, 1)` of each of its vertices `walk[start + i]`, `i < edges`.
+pub type SideFractions = Vec<Vec<f64>>;
+
+/// Arc-length fractions of every side of `cut`.
+pub fn arc_fractions(cut: &FeatureCutResult) -> SideFractions {
+    let (disk, walk) = (&cut.disk.mesh, &cut.walk);
+    cut.sides
+        .iter()
+        .map(|s| {
+            let mut t = 0.0;
+            (0..s.edges)
+                .map(|i| {
+                    let (v, w) = (walk[(s.start + i) % walk.len()], walk[(s.start + i + 1) % walk.len()]);
+                    let f = t / s.length.max(f64::MIN_POSITIVE);
+                    t += (disk.position(w) - disk.position(v)).norm();
+                    f
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// Interior angle of the disk at each of its vertices (sum of incident corner angles).
+fn corner_angles(cut: &FeatureCutResult) -> Vec<f64> {
+    let disk = &cut.disk.mesh;
+    let mut out = vec![0.0; disk.n_vertices()];
+    for f in disk.faces() {
+        let p = f.map(|v| disk.position(v));
+        for k in 0..3 {
+            let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+            out[f[k].idx()] += a.cross(&b).norm().atan2(a.dot(&b));
+        }
+    }
+    out
+}
+
+/// Fractions for the target's sides: curve sides warped onto the source's (see the module
+/// doc), links by arc length. `source` and `target` have the same side kinds (as
+/// [`super::feature_domain::shared_arcs`] checks).
+pub fn align_fractions(source: &FeatureCutResult, target: &FeatureCutResult, o: &CurveAlignOptions) -> SideFractions {
+    let (fs, mut ft) = (arc_fractions(source), arc_fractions(target));
+    let (angs, angt) = (corner_angles(source), corner_angles(target));
+    for (k, (ss, st)) in source.sides.iter().zip(&target.sides).enumerate() {
+        if !matches!(ss.kind, SideKind::Curve(_)) || ss.kind != st.kind {
+            continue;
+        }
+        let desc = |cut: &FeatureCutResult, ang: &[f64], edges: usize, start: usize| -> Vec<f64> {
+            (0..=edges).map(|i| ang[cut.walk[(start + i) % cut.walk.len()].idx()]).collect()
+        };
+        let (ds, dt) = (desc(source, &angs, ss.edges, ss.start), desc(target, &angt, st.edges, st.start));
+        let mut a = fs[k].clone();
+        a.push(1.0);
+        let mut b = ft[k].clone();
+        b.push(1.0);
+        if let Some(w) = warp(&a, &ds, &b, &dt, o) {
+            ft[k] = w;
+        }
+    }
+    ft
+}
+
+/// Target fractions (without the closing 1) warped onto the source's, or `None` when the
+/// sides are too long to align or too short to need it.
+fn warp(a: &[f64], da: &[f64], b: &[f64], db: &[f64], o: &CurveAlignOptions) -> Option<Vec<f64>> {
+    let (n, m) = (a.len(), b.len());
+    if n < 3 || m < 3 || n.checked_mul(m)? > o.max_cells {
+        return None;
+    }
+    let pi2 = std::f64::consts::PI * std::f64::consts::PI;
+    let w = o.window as isize;
+    let cost = |i: usize, j: usize| {
+        let s = (a[i] - b[j]) / o.band;
+        let mut d = 0.0;
+        for k in -w..=w {
+            let (x, y) = ((i as isize + k).clamp(0, n as isize - 1), (j as isize + k).clamp(0, m as isize - 1));
+            let e = da[x as usize] - db[y as usize];
+            d += e * e;
+        }
+        s * s + d / (pi2 * (2 * w + 1) as f64)
+    };
+    // Rolling cost rows; one byte per cell for the way back (0 diagonal, 1 from i - 1, 2 from
+    // j - 1). The ends are junctions: they match each other and nothing else.
+    let mut back = vec![0u8; n * m];
+    let mut prev = vec![f64::INFINITY; m];
+    let mut cur = vec![f64::INFINITY; m];
+    prev[0] = 0.0;
+    for j in 1..m {
+        prev[j] = prev[j - 1] + o.gap + cost(0, j);
+        back[j] = 2;
+    }
+    for i in 1..n {
+        cur[0] = prev[0] + o.gap + cost(i, 0);
+        back[i * m] = 1;
+        for j in 1..m {
+            let (d, u, l) = (prev[j - 1], prev[j] + o.gap, cur[j - 1] + o.gap);
+            let (best, dir) = if d <= u && d <= l {
+                (d, 0)
+            } else if u <= l {
+                (u, 1)
+            } else {
+                (l, 2)
+            };
+            cur[j] = best + cost(i, j);
+            back[i * m + j] = dir;
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    // Knots: the ends and every pair entered by a diagonal step (strictly increasing in both).
+    let end = (n - 1, m - 1);
+    let mut knots = vec![end];
+    let (mut i, mut j) = end;
+    while i > 0 || j > 0 {
+        let dir = back[i * m + j];
+        if dir == 0 && (i, j) != end {
+            knots.push((i, j));
+        }
+        match dir {
+            0 => {
+                i -= 1;
+                j -= 1;
+            }
+            1 => i -= 1,
+            _ => j -= 1,
+        }
+    }
+    // A knot level with the end (the path ran along the last row or column) would repeat the
+    // end's fraction.
+    if knots.len() > 1 && (knots[1].0 == end.0 || knots[1].1 == end.1) {
+        knots.remove(1);
+    }
+    knots.push((0, 0));
+    knots.reverse();
+    // Each target vertex between two knots: the source fraction interpolated by its arc length.
+    let mut out = vec![0.0; m - 1];
+    for win in knots.windows(2) {
+        let ((i0, j0), (i1, j1)) = (win[0], win[1]);
+        for (j, slot) in out.iter_mut().enumerate().take(j1.min(m - 1)).skip(j0) {
+            let t = if j1 > j0 { (b[j] - b[j0]) / (b[j1] - b[j0]).max(f64::MIN_POSITIVE) } else { 0.0 };
+            *slot = a[i0] + (a[i1] - a[i0]) * t;
+        }
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn zigzag(n: usize, shift: f64) -> (Vec<f64>, Vec<f64>) {
+        // Fractions with a smooth non-uniform drift, angles alternating tip / notch.
+        let f: Vec<f64> = (0..=n)
+            .map(|i| {
+                let t = i as f64 / n as f64;
+                t + shift * (std::f64::consts::PI * t).sin()
+            })
+            .collect();
+        let d = (0..=n).map(|i| if i % 2 == 0 { 1.0 } else { 4.5 }).collect();
+        (f, d)
+    }
+
+    #[test]
+    fn a_drifted_zigzag_is_matched_vertex_for_vertex() {
+        let (a, da) = zigzag(60, 0.0);
+        let (b, db) = zigzag(60, 0.03);
+        // Arc length alone is off by ~2 vertex spacings in the middle.
+        assert!((a[30] - b[30]).abs() > 1.5 / 60.0);
+        let w = warp(&a, &da, &b, &db, &CurveAlignOptions::default()).unwrap();
+        for (j, x) in w.iter().enumerate() {
+            assert!((x - a[j]).abs() < 1e-12, "vertex {j}: {x} vs {}", a[j]);
+        }
+    }
+
+    #[test]
+    fn warped_fractions_increase_strictly() {
+        let (a, da) = zigzag(40, 0.0);
+        let (b, db) = zigzag(97, -0.04);
+        let w = warp(&a, &da, &b, &db, &CurveAlignOptions::default()).unwrap();
+        assert_eq!(w.len(), 97);
+        assert_eq!(w[0], 0.0);
+        assert!(w.windows(2).all(|p| p[1] > p[0]), "{w:?}");
+        assert!(*w.last().unwrap() < 1.0);
+    }
+}

@@ -4,7 +4,7 @@
 //! are the same arc of the circle), and the composition of two bijections is one.
 
 use super::compose::{Planar, locate_all, warp_interior};
-use super::curve_align::{CurveAlignOptions, align_fractions, arc_fractions};
+use super::curve_align::{CurveAlignOptions, align_fractions, arc_fractions, loop_rotation};
 use super::feature_cut::{FeatureCutResult, chain_order, feature_cut};
 use super::feature_domain::{FeatureDomainResult, feature_domain, shared_arcs};
 use super::features::{Curve, CurveKind};
@@ -91,7 +91,17 @@ pub fn feature_map(
         (feature_cut(source, source_curves, &order, interior.map(|a| a.0), on_boundary.map(|a| a.0)), h.join())
     });
     let sc = sc?;
-    let tc = tc.map_err(|_| crate::Error::Internal("feature cut thread panicked".into()))??;
+    let mut tc = tc.map_err(|_| crate::Error::Internal("feature cut thread panicked".into()))??;
+    // An unlisted boundary loop starts where the chain arrives, on each mesh by its own shortest
+    // path; on a deformed copy the two arrivals can be several vertices apart, which turns the
+    // whole loop. When the loops' corner angles say by how much, the target's loop is started
+    // (and arrived at) there instead.
+    if on_boundary.is_none() && sc.curves.len() > source_curves.len() && tc.curves.len() > target_curves.len() {
+        let (sl, tl) = (&sc.curves[sc.curves.len() - 1].vertices, &tc.curves[tc.curves.len() - 1].vertices);
+        if let Some(r) = loop_rotation(source, sl, target, tl) {
+            tc = feature_cut(target, target_curves, &order, interior.map(|a| a.1), Some(tl[r]))?;
+        }
+    }
     let arcs = shared_arcs(&sc, &tc)?;
     let it = o.stretch_iterations;
     let tf = match &o.align {

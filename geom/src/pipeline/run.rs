@@ -82,10 +82,11 @@ pub(super) fn finish_direction(
     let mut v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
     let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
     let untangled = crate::crossparam::untangle::untangle(from, to, &mut m, fixed, &o.untangle)?;
-    if untangled.regions > 0 {
+    repaired += crate::crossparam::slide::slide_boundary(from, to, &mut m, fixed)?;
+    // Repairs, re-embedding and sliding place images anew; any of them can land on a hidden spot.
+    if repaired > 0 || untangled.regions > 0 {
         v += crate::crossparam::visible::make_visible(from, to, &mut m, fixed)?;
     }
-    repaired += crate::crossparam::slide::slide_boundary(from, to, &mut m, fixed)?;
     smoothed();
     progress.check()?;
     progress.report("metrics", 0.0);

@@ -182,6 +182,52 @@ fn warp(a: &[f64], da: &[f64], b: &[f64], db: &[f64], o: &CurveAlignOptions) -> 
     Some(out)
 }
 
+/// Interior angle of `mesh` at each vertex of the boundary loop `ring`.
+fn ring_angles(mesh: &crate::mesh::Mesh, ring: &[crate::mesh::VertexId]) -> Vec<f64> {
+    let mut at = std::collections::HashMap::with_capacity(ring.len());
+    for (i, v) in ring.iter().enumerate() {
+        at.insert(*v, i);
+    }
+    let mut out = vec![0.0; ring.len()];
+    for f in mesh.faces() {
+        for k in 0..3 {
+            if let Some(&i) = at.get(&f[k]) {
+                let p = f.map(|v| mesh.position(v));
+                let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+                out[i] += a.cross(&b).norm().atan2(a.dot(&b));
+            }
+        }
+    }
+    out
+}
+
+/// Loops longer than this are not searched for a rotation (the search is quadratic).
+const MAX_ROTATION_LOOP: usize = 4096;
+
+/// Where the target's copy of an unlisted boundary loop should start so that it lines up with
+/// the source's: both loops have the same vertex count and the cyclic shift `r` of the target's
+/// corner angles matches the source's far better than no shift and than shifts in general (a
+/// deformed copy of one boundary). `None` when no shift stands out (different shapes: the
+/// chain's own arrival point stays).
+pub fn loop_rotation(
+    source: &crate::mesh::Mesh,
+    source_ring: &[crate::mesh::VertexId],
+    target: &crate::mesh::Mesh,
+    target_ring: &[crate::mesh::VertexId],
+) -> Option<usize> {
+    let n = source_ring.len();
+    if n != target_ring.len() || !(8..=MAX_ROTATION_LOOP).contains(&n) {
+        return None;
+    }
+    let (a, b) = (ring_angles(source, source_ring), ring_angles(target, target_ring));
+    let cost: Vec<f64> = (0..n).map(|r| (0..n).map(|i| (a[i] - b[(i + r) % n]).powi(2)).sum()).collect();
+    let best = (0..n).min_by(|&x, &y| cost[x].total_cmp(&cost[y]))?;
+    let mut sorted = cost.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[n / 2];
+    (best != 0 && cost[best] <= 0.25 * cost[0] && cost[best] <= 0.25 * median).then_some(best)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -249,50 +295,4 @@ mod tests {
         assert!(w.windows(2).all(|p| p[1] > p[0]), "{w:?}");
         assert!(*w.last().unwrap() < 1.0);
     }
-}
-
-/// Interior angle of `mesh` at each vertex of the boundary loop `ring`.
-fn ring_angles(mesh: &crate::mesh::Mesh, ring: &[crate::mesh::VertexId]) -> Vec<f64> {
-    let mut at = std::collections::HashMap::with_capacity(ring.len());
-    for (i, v) in ring.iter().enumerate() {
-        at.insert(*v, i);
-    }
-    let mut out = vec![0.0; ring.len()];
-    for f in mesh.faces() {
-        for k in 0..3 {
-            if let Some(&i) = at.get(&f[k]) {
-                let p = f.map(|v| mesh.position(v));
-                let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
-                out[i] += a.cross(&b).norm().atan2(a.dot(&b));
-            }
-        }
-    }
-    out
-}
-
-/// Loops longer than this are not searched for a rotation (the search is quadratic).
-const MAX_ROTATION_LOOP: usize = 4096;
-
-/// Where the target's copy of an unlisted boundary loop should start so that it lines up with
-/// the source's: both loops have the same vertex count and the cyclic shift `r` of the target's
-/// corner angles matches the source's far better than no shift and than shifts in general (a
-/// deformed copy of one boundary). `None` when no shift stands out (different shapes: the
-/// chain's own arrival point stays).
-pub fn loop_rotation(
-    source: &crate::mesh::Mesh,
-    source_ring: &[crate::mesh::VertexId],
-    target: &crate::mesh::Mesh,
-    target_ring: &[crate::mesh::VertexId],
-) -> Option<usize> {
-    let n = source_ring.len();
-    if n != target_ring.len() || n < 8 || n > MAX_ROTATION_LOOP {
-        return None;
-    }
-    let (a, b) = (ring_angles(source, source_ring), ring_angles(target, target_ring));
-    let cost: Vec<f64> = (0..n).map(|r| (0..n).map(|i| (a[i] - b[(i + r) % n]).powi(2)).sum()).collect();
-    let best = (0..n).min_by(|&x, &y| cost[x].total_cmp(&cost[y]))?;
-    let mut sorted = cost.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[n / 2];
-    (best != 0 && cost[best] <= 0.25 * cost[0] && cost[best] <= 0.25 * median).then_some(best)
 }

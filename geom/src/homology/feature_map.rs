@@ -31,7 +31,8 @@ pub struct FeatureMapOptions {
     /// Stretch-reweighting rounds of each domain (0 = the plain mean-value map).
     pub stretch_iterations: usize,
     /// Align the target's curve sides to the source's vertex by vertex
-    /// ([`super::curve_align`]); `None` places both by arc length.
+    /// ([`super::curve_align`]) and turn an unlisted boundary loop to match; `None` places both
+    /// by arc length from their own chain arrivals.
     pub align: Option<CurveAlignOptions>,
 }
 
@@ -96,7 +97,8 @@ pub fn feature_map(
     // path; on a deformed copy the two arrivals can be several vertices apart, which turns the
     // whole loop. When the loops' corner angles say by how much, the target's loop is started
     // (and arrived at) there instead.
-    if on_boundary.is_none() && sc.curves.len() > source_curves.len() && tc.curves.len() > target_curves.len() {
+    let unlisted = sc.curves.len() > source_curves.len() && tc.curves.len() > target_curves.len();
+    if o.align.is_some() && on_boundary.is_none() && unlisted {
         let (sl, tl) = (&sc.curves[sc.curves.len() - 1].vertices, &tc.curves[tc.curves.len() - 1].vertices);
         if let Some(r) = loop_rotation(source, sl, target, tl) {
             tc = feature_cut(target, target_curves, &order, interior.map(|a| a.1), Some(tl[r]))?;

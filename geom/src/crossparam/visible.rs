@@ -10,11 +10,19 @@ use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, P3, VertexId};
 use crate::metrics::SurfaceIndex;
 
-/// Moves hidden points; returns how many moved.
+/// Moves hidden points; returns how many moved. With `reveal`, a point whose every visible
+/// spot counts more folds in its star still moves (to the least folded one): the folds were
+/// there, hidden with it, and the fold repairs that run next can now see them.
 ///
 /// # Errors
 /// `Error::Internal` if the index cannot be built.
-pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &[VertexId]) -> crate::Result<usize> {
+pub fn make_visible(
+    source: &Mesh,
+    target: &Mesh,
+    map: &mut SurfaceMap,
+    fixed: &[VertexId],
+    reveal: bool,
+) -> crate::Result<usize> {
     let index = SurfaceIndex::new(target)?;
     let tol = 1e-9 * target.bbox_diagonal();
     let n = source.n_vertices();
@@ -65,16 +73,35 @@ pub fn make_visible(source: &Mesh, target: &Mesh, map: &mut SurfaceMap, fixed: &
                 .filter(|&g| g != f)
                 .flat_map(|g| std::iter::once((g, [1.0 / 3.0; 3])).chain(halfway.iter().map(move |&nb| (g, nb)))),
         );
+        let mut fallback: Option<(usize, crate::FaceId, [f64; 3], P3)> = None;
+        let mut done = false;
         for (g, nb) in tries {
             let [p0, p1, p2] = target.face_points(g);
             let p = P3::from(p0.coords * nb[0] + p1.coords * nb[1] + p2.coords * nb[2]);
-            if index.query(&p).distance <= tol && flipped_in_star(source, target, v, p, g, &pos, &map.face) <= before {
+            if index.query(&p).distance > tol {
+                continue;
+            }
+            let flips = flipped_in_star(source, target, v, p, g, &pos, &map.face);
+            if flips <= before {
                 map.face[vi] = g;
                 map.bary[vi] = nb;
                 pos[vi] = p;
                 moved += 1;
+                done = true;
                 break;
             }
+            if fallback.as_ref().is_none_or(|x| flips < x.0) {
+                fallback = Some((flips, g, nb, p));
+            }
+        }
+        // Every visible spot shows more folds: the hidden image was masking them (the rule read
+        // a wrong face's normal). With `reveal`, the least folded visible spot is taken so that
+        // the repairs that follow see the folds.
+        if let (false, true, Some((_, g, nb, p))) = (done, reveal, fallback) {
+            map.face[vi] = g;
+            map.bary[vi] = nb;
+            pos[vi] = p;
+            moved += 1;
         }
     }
     Ok(moved)

@@ -1,9 +1,12 @@
 //! Writes the `map` benchmark's 58k-vs-6k case so the CLI can be timed end to end:
 //! `cargo run --release -p surfmap-geom --example armadillo_58k -- DIR` writes `fine.obj` (armadillo
 //! subdivided once), `coarse.obj` (a 6k-vertex simplification) and `anchors.json` (45 farthest
-//! points of the coarse mesh and their partners), then
+//! points of the coarse mesh and their partners, as `benches/map.rs` picks them), then
 //! `surfmap map DIR/fine.obj DIR/coarse.obj --anchors DIR/anchors.json --out OUT`.
 use std::path::{Path, PathBuf};
+
+#[path = "../benches/common/mod.rs"]
+mod common;
 
 fn main() {
     let Some(dir) = std::env::args().nth(1).map(PathBuf::from) else {
@@ -17,8 +20,7 @@ fn main() {
 }
 
 fn run(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
-    let shared = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes/armadillo.obj");
-    let s = geom::io::read_path(&shared, &Default::default())?.mesh;
+    let s = geom::io::read_path(&common::shared("armadillo.obj"), &Default::default())?.mesh;
     let fine = geom::mesh::shapes::subdivide(&s, 1);
     let opts = geom::simplify::DecimateOptions { target_vertices: 6000, ..Default::default() };
     let coarse = geom::simplify::decimate(&s, &opts)?;
@@ -26,22 +28,7 @@ fn run(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     geom::io::write_path(&fine, &dir.join("fine.obj"))?;
     geom::io::write_path(&coarse.mesh, &dir.join("coarse.obj"))?;
     let anchors: Vec<[u64; 2]> =
-        fps(&coarse.mesh, 45).into_iter().map(|a| [u64::from(coarse.kept[a].0), a as u64]).collect();
+        common::fps(&coarse.mesh, 45).into_iter().map(|a| [u64::from(coarse.kept[a as usize].0), a]).collect();
     std::fs::write(dir.join("anchors.json"), format!("{{\"anchors\": {anchors:?}}}"))?;
     Ok(())
-}
-
-/// Farthest-point sampling by Euclidean distance from vertex 0 (as the benchmark does).
-fn fps(m: &geom::mesh::Mesh, k: usize) -> Vec<usize> {
-    let p = m.positions();
-    let mut d: Vec<f64> = p.iter().map(|x| (x - p[0]).norm()).collect();
-    let mut out = vec![0];
-    while out.len() < k {
-        let i = (0..p.len()).max_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap_or(0);
-        out.push(i);
-        for (j, x) in p.iter().enumerate() {
-            d[j] = d[j].min((x - p[i]).norm());
-        }
-    }
-    out
 }

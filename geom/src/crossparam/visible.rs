@@ -73,8 +73,11 @@ pub fn make_visible(
                 .filter(|&g| g != f)
                 .flat_map(|g| std::iter::once((g, [1.0 / 3.0; 3])).chain(halfway.iter().map(move |&nb| (g, nb)))),
         );
-        let mut fallback: Option<(usize, crate::FaceId, [f64; 3], P3)> = None;
-        let mut done = false;
+        // The first visible spot that adds no fold; failing that, with `reveal`, the least folded
+        // visible one: the hidden image was masking those folds (the rule read a wrong face's
+        // normal), and the repairs that follow can see them once it is visible.
+        let mut kept: Option<(crate::FaceId, [f64; 3], P3)> = None;
+        let mut least: Option<(usize, crate::FaceId, [f64; 3], P3)> = None;
         for (g, nb) in tries {
             let [p0, p1, p2] = target.face_points(g);
             let p = P3::from(p0.coords * nb[0] + p1.coords * nb[1] + p2.coords * nb[2]);
@@ -83,21 +86,15 @@ pub fn make_visible(
             }
             let flips = flipped_in_star(source, target, v, p, g, &pos, &map.face);
             if flips <= before {
-                map.face[vi] = g;
-                map.bary[vi] = nb;
-                pos[vi] = p;
-                moved += 1;
-                done = true;
+                kept = Some((g, nb, p));
                 break;
             }
-            if fallback.as_ref().is_none_or(|x| flips < x.0) {
-                fallback = Some((flips, g, nb, p));
+            if least.as_ref().is_none_or(|x| flips < x.0) {
+                least = Some((flips, g, nb, p));
             }
         }
-        // Every visible spot shows more folds: the hidden image was masking them (the rule read
-        // a wrong face's normal). With `reveal`, the least folded visible spot is taken so that
-        // the repairs that follow see the folds.
-        if let (false, true, Some((_, g, nb, p))) = (done, reveal, fallback) {
+        let least = least.filter(|_| reveal).map(|(_, g, nb, p)| (g, nb, p));
+        if let Some((g, nb, p)) = kept.or(least) {
             map.face[vi] = g;
             map.bary[vi] = nb;
             pos[vi] = p;

@@ -60,12 +60,11 @@ pub fn arc_fractions(cut: &FeatureCutResult) -> SideFractions {
         .collect()
 }
 
-/// Interior angle of the disk at each of its vertices (sum of incident corner angles).
-fn corner_angles(cut: &FeatureCutResult) -> Vec<f64> {
-    let disk = &cut.disk.mesh;
-    let mut out = vec![0.0; disk.n_vertices()];
-    for f in disk.faces() {
-        let p = f.map(|v| disk.position(v));
+/// Sum of the corner angles at every vertex of `mesh` (a boundary vertex's interior angle).
+fn angle_sums(mesh: &crate::mesh::Mesh) -> Vec<f64> {
+    let mut out = vec![0.0; mesh.n_vertices()];
+    for f in mesh.faces() {
+        let p = f.map(|v| mesh.position(v));
         for k in 0..3 {
             let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
             out[f[k].idx()] += a.cross(&b).norm().atan2(a.dot(&b));
@@ -79,7 +78,7 @@ fn corner_angles(cut: &FeatureCutResult) -> Vec<f64> {
 /// [`super::feature_domain::shared_arcs`] checks).
 pub fn align_fractions(source: &FeatureCutResult, target: &FeatureCutResult, o: &CurveAlignOptions) -> SideFractions {
     let (fs, mut ft) = (arc_fractions(source), arc_fractions(target));
-    let (angs, angt) = (corner_angles(source), corner_angles(target));
+    let (angs, angt) = (angle_sums(&source.disk.mesh), angle_sums(&target.disk.mesh));
     for (k, (ss, st)) in source.sides.iter().zip(&target.sides).enumerate() {
         if !matches!(ss.kind, SideKind::Curve(_)) || ss.kind != st.kind {
             continue;
@@ -182,25 +181,6 @@ fn warp(a: &[f64], da: &[f64], b: &[f64], db: &[f64], o: &CurveAlignOptions) -> 
     Some(out)
 }
 
-/// Interior angle of `mesh` at each vertex of the boundary loop `ring`.
-fn ring_angles(mesh: &crate::mesh::Mesh, ring: &[crate::mesh::VertexId]) -> Vec<f64> {
-    let mut at = std::collections::HashMap::with_capacity(ring.len());
-    for (i, v) in ring.iter().enumerate() {
-        at.insert(*v, i);
-    }
-    let mut out = vec![0.0; ring.len()];
-    for f in mesh.faces() {
-        for k in 0..3 {
-            if let Some(&i) = at.get(&f[k]) {
-                let p = f.map(|v| mesh.position(v));
-                let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
-                out[i] += a.cross(&b).norm().atan2(a.dot(&b));
-            }
-        }
-    }
-    out
-}
-
 /// Loops longer than this are not searched for a rotation (the search is quadratic).
 const MAX_ROTATION_LOOP: usize = 4096;
 
@@ -219,7 +199,9 @@ pub fn loop_rotation(
     if n != target_ring.len() || !(8..=MAX_ROTATION_LOOP).contains(&n) {
         return None;
     }
-    let (a, b) = (ring_angles(source, source_ring), ring_angles(target, target_ring));
+    let (sa, sb) = (angle_sums(source), angle_sums(target));
+    let a: Vec<f64> = source_ring.iter().map(|v| sa[v.idx()]).collect();
+    let b: Vec<f64> = target_ring.iter().map(|v| sb[v.idx()]).collect();
     let cost: Vec<f64> = (0..n).map(|r| (0..n).map(|i| (a[i] - b[(i + r) % n]).powi(2)).sum()).collect();
     let best = (0..n).min_by(|&x, &y| cost[x].total_cmp(&cost[y]))?;
     let mut sorted = cost.clone();

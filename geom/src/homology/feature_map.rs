@@ -135,8 +135,8 @@ pub(crate) fn angle(p: [f64; 2]) -> f64 {
 /// polygon, by angle: the point between the two boundary vertices whose angles enclose it, at
 /// the fraction of the angle (angles increase along every side on both disks, and side ends
 /// share their angles, so junctions land on junctions, every curve vertex on its partner curve,
-/// and a vertex aligned with a partner vertex exactly on it). A grid search would clamp such points into whichever
-/// triangle is least outside, which need not be the one on the chord.
+/// and a vertex aligned with a partner vertex exactly on it). A grid search would clamp such
+/// points into whichever triangle is least outside, which need not be the one on the chord.
 ///
 /// # Errors
 /// `Internal` when a boundary edge of the disk is no edge of the mesh.

@@ -11,7 +11,9 @@ Features are built on each mesh: k centres by farthest-point sampling among inte
 least two rings from the boundary, each a shortest edge path of about 6% of the bounding-box
 diagonal along the mesh's main axis, two rings apart from each other. On same-shape cases the
 target's features are the same vertices (so the ground truth agrees with them). The boundary
-loop is appended as a feature by the service itself.
+loop is appended as a feature by the service itself. Such features do not correspond between
+different shapes; the last case places four at anatomically corresponding spots of two heads
+(eyes, nose ridge, mouth; see HEADS).
 """
 import json
 import os
@@ -88,6 +90,40 @@ def features(V, F, k):
     return paths
 
 
+def frontmost(V, xy, r):
+    """The vertex nearest the viewer (largest z) within `r` of `xy` in the xy-plane."""
+    idx = np.nonzero(np.linalg.norm(V[:, :2] - np.array(xy), axis=1) < r)[0]
+    return int(idx[V[idx, 2].argmax()])
+
+
+def edge_path(V, F, a, b):
+    """Shortest edge path from vertex a to vertex b."""
+    E = edges_of(F)
+    w = np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)
+    G = csr_matrix((w, (E[:, 0], E[:, 1])), shape=(len(V), len(V)))
+    _, pred = dijkstra(G, directed=False, indices=a, return_predecessors=True)
+    p = [b]
+    while p[-1] != a:
+        p.append(int(pred[p[-1]]))
+    return np.array(p[::-1])
+
+
+# Two heads facing +z with anatomically corresponding features, read off front depth renders:
+# left eye, right eye (inner to outer corner), nose ridge (brow to tip), mouth (corner to corner);
+# each end is the front-most vertex within r of the given (x, y).
+HEADS = {
+    "demosthenes-low-res.obj": ([[(0.02, 1.19), (0.12, 1.19)], [(0.26, 1.19), (0.36, 1.19)],
+                                 [(0.19, 1.25), (0.19, 1.0)], [(0.10, 0.92), (0.28, 0.92)]], 0.03),
+    "camelhead.off": ([[(-0.16, 0.10), (-0.07, 0.10)], [(0.07, 0.10), (0.16, 0.10)],
+                       [(0.0, 0.10), (0.0, -0.17)], [(-0.08, -0.2), (0.08, -0.2)]], 0.012),
+}
+
+
+def head_features(name, V, F):
+    segs, r = HEADS[name]
+    return [edge_path(V, F, frontmost(V, a, r), frontmost(V, b, r)) for a, b in segs]
+
+
 def run(binary, tmp, s, t, feats, anchors, gt):
     spec = {"method": "homology", "anchors": anchors,
             "features": [{"source": [int(x) for x in a], "target": [int(x) for x in b]} for a, b in feats]}
@@ -109,7 +145,8 @@ def main():
             ("bunny twisted (closed)", "bunny.off", "twist"), ("face shuffled", "face.off", "shuffle")]
     diff = [("face ↔ hand", "face.off", "hand_lowres.obj"), ("face ↔ demosthenes", "face.off", "demosthenes-low-res.obj"),
             ("demosthenes ↔ camelhead", "demosthenes-low-res.obj", "camelhead.off"),
-            ("cow ↔ horse (closed)", "cow.off", "horse.off")]
+            ("cow ↔ horse (closed)", "cow.off", "horse.off"),
+            ("demosthenes ↔ camelhead, anatomical", "demosthenes-low-res.obj", "camelhead.off")]
     print("| case | #v (s/t) | features | time s | E_ang | L2 | flips s→t/t→s | area | off-surface | feature err | gt mean | word |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
@@ -128,7 +165,10 @@ def main():
             s, t = os.path.join(M, a), os.path.join(M, b)
             VS, FS = mm.load_mesh(s)
             VT, FT = mm.load_mesh(t)
-            fs, ft = features(VS.astype(float), FS, k), features(VT.astype(float), FT, k)
+            if name.endswith("anatomical"):
+                fs, ft = head_features(a, VS.astype(float), FS), head_features(b, VT.astype(float), FT)
+            else:
+                fs, ft = features(VS.astype(float), FS, k), features(VT.astype(float), FT, k)
             rows.append((name, s, t, list(zip(fs, ft)), None))
         for name, s, t, feats, gt in rows:
             nv = f"{len(mm.load_mesh(s)[0])}/{len(mm.load_mesh(t)[0])}"

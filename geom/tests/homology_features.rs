@@ -1,7 +1,8 @@
 //! Method `homology` with feature curves and boundary loops (Carner et al. section 3.4) on
 //! shared meshes: genus-0 surfaces, closed and with a boundary loop, four features each. Every
 //! feature vertex lands on its partner curve, nothing folds, both outputs keep the input faces,
-//! and bad curves are refused with a typed error.
+//! and bad curves are refused with a typed error. Two different heads with anatomically placed
+//! features map without folds as well.
 
 use geom::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
 use geom::mesh::{Mesh, VertexId};
@@ -195,6 +196,71 @@ fn feature_jobs_build_the_meta_mesh() {
     let stats = r.features.as_ref().unwrap().meta_mesh.clone().expect("meta-mesh statistics");
     assert!(stats.error.is_none() && stats.pruned_vertices.is_some_and(|p| p > 0), "{stats:?}");
     common::meta_pair(&arts, &a, &b, "face / hand, pruned at 10°", true);
+}
+
+/// The vertex nearest the viewer (largest z) within `r` of `(x, y)`.
+fn frontmost(m: &Mesh, (x, y): (f64, f64), r: f64) -> VertexId {
+    (0..m.n_vertices())
+        .map(VertexId::from_idx)
+        .filter(|&v| {
+            let p = m.position(v);
+            (p.x - x).hypot(p.y - y) < r
+        })
+        .max_by(|&a, &b| m.position(a).z.total_cmp(&m.position(b).z))
+        .expect("a vertex near the spot")
+}
+
+/// Shortest edge paths between the front-most vertices near each pair of spots.
+fn head_curves(m: &Mesh, spots: &[[(f64, f64); 2]], r: f64) -> Vec<Vec<VertexId>> {
+    spots
+        .iter()
+        .map(|[a, b]| {
+            let (a, b) = (frontmost(m, *a, r), frontmost(m, *b, r));
+            let o = VertexDijkstraOptions { target: Some(b), ..Default::default() };
+            vertex_dijkstra(m, &[(a, 0.0)], &o).unwrap().path_to(b).unwrap()
+        })
+        .collect()
+}
+
+/// Two heads, both open at the neck (the boundary loops become the fifth feature), with four
+/// features at anatomically corresponding places, read off front depth renders as in
+/// `bench/homology_features.py`: the eyes (inner to outer corner), the nose ridge (brow to tip)
+/// and the mouth (corner to corner). Every feature lands on its partner and nothing folds
+/// either way. Before the two sides of each curve were made to agree, the left eye's tip folded
+/// one face of the camel on the bust.
+#[test]
+fn two_heads_with_anatomical_features_map_without_folds() {
+    let (a, b) = (load("demosthenes-low-res.obj"), load("camelhead.off"));
+    let ca = head_curves(
+        &a,
+        &[
+            [(0.02, 1.19), (0.12, 1.19)],
+            [(0.26, 1.19), (0.36, 1.19)],
+            [(0.19, 1.25), (0.19, 1.0)],
+            [(0.10, 0.92), (0.28, 0.92)],
+        ],
+        0.03,
+    );
+    let cb = head_curves(
+        &b,
+        &[
+            [(-0.16, 0.10), (-0.07, 0.10)],
+            [(0.07, 0.10), (0.16, 0.10)],
+            [(0.0, 0.10), (0.0, -0.17)],
+            [(-0.08, -0.2), (0.08, -0.2)],
+        ],
+        0.012,
+    );
+    let (r, arts) = run_map(&spec_pairs(ca.iter().zip(&cb), vec![]), &a, &b, &mut NoProgress).unwrap();
+    let f = r.features.as_ref().expect("a feature report");
+    assert_eq!(f.curves, 5, "four features and the neck: {}", f.word);
+    assert!(f.word.contains("B5"), "{}", f.word);
+    assert!(f.feature_error[0] <= 1e-9 && f.feature_error[1] <= 1e-9, "{:?}", f.feature_error);
+    assert_eq!(f.domain_flips, [0, 0]);
+    assert_eq!((r.source_to_target.flipped_faces, r.target_to_source.flipped_faces), (0, 0));
+    let mapped = common::source_on_target(&arts, &a, &b);
+    assert_eq!(mapped.faces(), a.faces());
+    assert!(r.source_to_target.off_surface_max <= 1e-9 && r.target_to_source.off_surface_max <= 1e-9);
 }
 
 #[test]

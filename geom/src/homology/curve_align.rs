@@ -95,7 +95,38 @@ pub fn align_fractions(source: &FeatureCutResult, target: &FeatureCutResult, o: 
             ft[k] = w;
         }
     }
+    agree_on_both_sides(target, &mut ft);
     ft
+}
+
+/// An open curve is cut into two sides that run along the same vertices, once each way, and
+/// each side is warped on its own. Where the two warps put a vertex at different places, the
+/// faces on one side of the curve see it where those on the other do not: at the curve's tip,
+/// where both sides meet, a face can then span more than a half-turn of the tip's fan and fold.
+/// Each vertex takes the mean of its two fractions (one mirrored), which keeps both sides
+/// strictly increasing and makes them agree.
+fn agree_on_both_sides(cut: &FeatureCutResult, ft: &mut SideFractions) {
+    let orig =
+        |side: &super::feature_cut::Side, i: usize| cut.disk.orig[cut.walk[(side.start + i) % cut.walk.len()].idx()];
+    for k in 0..cut.sides.len() {
+        let a = cut.sides[k];
+        let Some(r) = (k + 1..cut.sides.len()).find(|&r| cut.sides[r].kind == a.kind) else { continue };
+        let b = cut.sides[r];
+        let e = a.edges;
+        if !matches!(a.kind, SideKind::Curve(_))
+            || b.edges != e
+            || ft[k].len() != e
+            || ft[r].len() != e
+            || !(0..=e).all(|i| orig(&a, i) == orig(&b, e - i))
+        {
+            continue;
+        }
+        for i in 1..e {
+            let t = 0.5 * (ft[k][i] + 1.0 - ft[r][e - i]);
+            ft[k][i] = t;
+            ft[r][e - i] = 1.0 - t;
+        }
+    }
 }
 
 /// Target fractions (without the closing 1) warped onto the source's, or `None` when the
@@ -276,5 +307,42 @@ mod tests {
         assert_eq!(w[0], 0.0);
         assert!(w.windows(2).all(|p| p[1] > p[0]), "{w:?}");
         assert!(*w.last().unwrap() < 1.0);
+    }
+
+    /// A curve across the middle of the wobbly grid, cut on the grid and on a copy whose
+    /// vertices crowd towards one end: each side is warped on its own, and afterwards the two
+    /// sides of the curve put every vertex at the same place (one side's fractions mirror the
+    /// other's).
+    #[test]
+    fn both_sides_of_an_open_curve_agree() {
+        use super::super::feature_cut::feature_cut;
+        use super::super::features::{Curve, CurveKind};
+        let (s, _) = wobbly_pair();
+        // Row 6 of the 13 x 13 grid, away from the boundary.
+        let row: Vec<crate::mesh::VertexId> = (2..11).map(|i| crate::mesh::VertexId(6 * 13 + i)).collect();
+        for w in row.windows(2) {
+            assert!(s.vertex_neighbors(w[0]).any(|x| x == w[1]), "the row is an edge path");
+        }
+        let crowded = s
+            .positions()
+            .iter()
+            .map(|p| crate::mesh::P3::new(p.x * p.x, p.y + 0.1 * (9.0 * p.x).sin(), 0.3 * p.x * p.y))
+            .collect();
+        let t = s.with_positions(crowded).unwrap();
+        let curves = [Curve { vertices: row.clone(), kind: CurveKind::Open }];
+        let (sc, tc) = (
+            feature_cut(&s, &curves, &[(0, false)], None, None).unwrap(),
+            feature_cut(&t, &curves, &[(0, false)], None, None).unwrap(),
+        );
+        let ft = align_fractions(&sc, &tc, &CurveAlignOptions::default());
+        let sides: Vec<usize> = (0..tc.sides.len()).filter(|&k| tc.sides[k].kind == SideKind::Curve(0)).collect();
+        assert_eq!(sides.len(), 2, "an open curve has two sides");
+        let (a, b) = (&ft[sides[0]], &ft[sides[1]]);
+        let e = a.len();
+        assert_eq!(b.len(), e);
+        for i in 1..e {
+            assert!((a[i] - (1.0 - b[e - i])).abs() < 1e-12, "vertex {i}: {} against {}", a[i], 1.0 - b[e - i]);
+        }
+        assert!(a.windows(2).all(|p| p[1] > p[0]) && b.windows(2).all(|p| p[1] > p[0]));
     }
 }

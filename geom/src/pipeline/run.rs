@@ -80,12 +80,21 @@ pub(super) fn finish_direction(
     let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
     let (mut m, r) = smooth::smooth(from, to, map, fixed, &o.smoothing, progress)?;
     let mut v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed, true)?;
-    let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed)?;
+    let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed, false)?;
     let untangled = crate::crossparam::untangle::untangle(from, to, &mut m, fixed, &o.untangle)?;
     repaired += crate::crossparam::slide::slide_boundary(from, to, &mut m, fixed)?;
     // Repairs, re-embedding and sliding place images anew; any of them can land on a hidden spot.
     if repaired > 0 || untangled.regions > 0 {
         v += crate::crossparam::visible::make_visible(from, to, &mut m, fixed, false)?;
+    }
+    // Folds the re-embedding could not undo get one more round of one-vertex repairs, now with
+    // spots spread over the target around each star (a crushed region between different shapes).
+    if untangled.folded_after > 0 {
+        let late = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed, true)?;
+        if late > 0 {
+            repaired += late;
+            v += crate::crossparam::visible::make_visible(from, to, &mut m, fixed, false)?;
+        }
     }
     smoothed();
     progress.check()?;

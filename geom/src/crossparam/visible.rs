@@ -167,9 +167,8 @@ pub(crate) fn fold_suspects(source: &Mesh, map: &SurfaceMap, pos: &[P3], tn: &[c
 
 /// When no move towards the neighbours lowers the flips of `v`'s star (`cur`): the spot among
 /// [`surface_samples`] around the star's images with the fewest flips, nearest the neighbours'
-/// images among equals (least spring energy), that reaches no further than
-/// [`STAR_GROWTH`] times the star's farthest neighbour, so a fold is not traded for long chords
-/// through the air.
+/// images among equals (least spring energy), that reaches no further from the neighbours than
+/// the vertex already does, so a fold is not traded for long chords through the air.
 #[allow(clippy::too_many_arguments)]
 fn surface_move(
     target: &Mesh,
@@ -185,7 +184,7 @@ fn surface_move(
     let nbrs: Vec<VertexId> = source.vertex_neighbors(v).collect();
     let reach = |p: &P3| nbrs.iter().map(|w| (p - pos[w.idx()]).norm()).fold(0.0, f64::max);
     let spring = |p: &P3| nbrs.iter().map(|w| (p - pos[w.idx()]).norm_squared()).sum::<f64>();
-    let max_reach = STAR_GROWTH * reach(&pos[v.idx()]);
+    let max_reach = reach(&pos[v.idx()]);
     let mut best: Option<(usize, f64, crate::topology::Projection, crate::FaceId)> = None;
     for pr in surface_samples(target, nbrs.iter().chain([&v]).map(|w| near[w.idx()])) {
         if reach(&pr.point) > max_reach {
@@ -248,9 +247,6 @@ fn surface_samples(target: &Mesh, faces: impl Iterator<Item = crate::FaceId>) ->
         })
         .collect()
 }
-
-/// How much further than its current farthest neighbour a repaired vertex may reach.
-const STAR_GROWTH: f64 = 1.0;
 
 /// Passes of [`repair_flips`] at most.
 const REPAIR_PASSES: usize = 8;

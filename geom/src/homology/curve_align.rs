@@ -110,15 +110,14 @@ fn agree_on_both_sides(cut: &FeatureCutResult, ft: &mut SideFractions) {
         |side: &super::feature_cut::Side, i: usize| cut.disk.orig[cut.walk[(side.start + i) % cut.walk.len()].idx()];
     for k in 0..cut.sides.len() {
         let a = cut.sides[k];
+        if !matches!(a.kind, SideKind::Curve(_)) {
+            continue;
+        }
+        // The return side of the same curve (a boundary loop has none).
         let Some(r) = (k + 1..cut.sides.len()).find(|&r| cut.sides[r].kind == a.kind) else { continue };
         let b = cut.sides[r];
         let e = a.edges;
-        if !matches!(a.kind, SideKind::Curve(_))
-            || b.edges != e
-            || ft[k].len() != e
-            || ft[r].len() != e
-            || !(0..=e).all(|i| orig(&a, i) == orig(&b, e - i))
-        {
+        if b.edges != e || ft[k].len() != e || ft[r].len() != e || !(0..=e).all(|i| orig(&a, i) == orig(&b, e - i)) {
             continue;
         }
         for i in 1..e {

@@ -38,6 +38,10 @@ def main():
         ("eight_lowres shuffled (g2)", "eight_lowres.off", "shuffle", 2),
         ("genus3 twisted (g3)", "genus3.off", "twist", 3),
         ("3holes bent (g3)", "3holes.off", "bend", 3),
+        ("torus subdivided (g1)", "torus.obj", "subdivided", 1),
+        ("kitten subdivided (g1)", "kitten.nf20k.off", "subdivided", 1),
+        ("eight_lowres subdivided (g2)", "eight_lowres.off", "subdivided", 2),
+        ("3holes subdivided (g3)", "3holes.off", "subdivided", 3),
     ]
     with tempfile.TemporaryDirectory() as tmp:
         print("| case | basis s,t / rotation | time s | flips s→t/t→s | area | L2 | E_ang | anchor | gt mean | H1 |")

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Method `homology` with feature curves and boundary loops (genus 0), judged by
+"""Method `homology` with feature curves (boundary loops on genus 0), judged by
 ../shared/eval/meshmetrics.py: same-shape cases (known correspondence) and different shapes.
 
 usage: [FEATURES=k] [META=1] python3 bench/homology_features.py [path/to/surfmap] [filter]
@@ -13,7 +13,9 @@ diagonal along the mesh's main axis, two rings apart from each other. On same-sh
 target's features are the same vertices (so the ground truth agrees with them). The boundary
 loop is appended as a feature by the service itself. Such features do not correspond between
 different shapes; the last case places four at anatomically corresponding spots of two heads
-(eyes, nose ridge, mouth; see HEADS).
+(eyes, nose ridge, mouth; see HEADS). On surfaces with handles the base anchor is the vertex
+farthest from every feature (same vertex on the target), and the first homotopy class (basis pair,
+rotation) that maps without flips is reported with the class.
 """
 import json
 import os
@@ -124,15 +126,31 @@ def head_features(name, V, F):
     return [edge_path(V, F, frontmost(V, a, r), frontmost(V, b, r)) for a, b in segs]
 
 
-def run(binary, tmp, s, t, feats, anchors, gt):
+def run(binary, tmp, s, t, feats, anchors, gt, cls=None):
     spec = {"method": "homology", "anchors": anchors,
-            "features": [{"source": [int(x) for x in a], "target": [int(x) for x in b]} for a, b in feats]}
+            "features": [{"source": [int(x) for x in a], "target": [int(x) for x in b]} for a, b in feats],
+            "options": {}}
     if os.environ.get("META"):
-        spec["options"] = {"meta_mesh": True}
+        spec["options"]["meta_mesh"] = True
+    if cls:
+        spec["options"].update(basis=list(cls[0]), rotation=cls[1])
     e = table2.run(binary, tmp, "", s, t, anchors or None, gt, "homology", spec=spec, repeats=1)
     if "error" not in e:
         e["features"] = e["report"]["features"]
     return e
+
+
+def run_classes(binary, tmp, s, t, feats, anchors, gt, genus):
+    """Homotopy classes (basis pair in {0,1}², then rotation τ) until one has 0 flips both ways;
+    a deformation can change which loops are shortest, so the true class need not be the first.
+    Returns the run and the class tried last."""
+    for bs in range(2):
+        for bt in range(2):
+            for r in range(4 if genus == 1 else genus):
+                e = run(binary, tmp, s, t, feats, anchors, gt, ((bs, bt), r))
+                if "error" in e or (e["flipped_faces"] == 0 and e["rev_flips"] == 0):
+                    return e, f"{bs},{bt} τ{r}"
+    return e, f"{bs},{bt} τ{r}"
 
 
 def main():
@@ -142,7 +160,10 @@ def main():
     k = int(os.environ.get("FEATURES", "4"))
     same = [("face bent", "face.off", "bend"), ("face twisted", "face.off", "twist"),
             ("hand bent", "hand_lowres.obj", "bend"), ("camelhead twisted", "camelhead.off", "twist"),
-            ("bunny twisted (closed)", "bunny.off", "twist"), ("face shuffled", "face.off", "shuffle")]
+            ("bunny twisted (closed)", "bunny.off", "twist"), ("face shuffled", "face.off", "shuffle"),
+            ("kitten twisted (genus 1)", "kitten.nf20k.off", "twist"), ("torus shuffled (genus 1)", "torus.obj", "shuffle"),
+            ("eight bent (genus 2)", "eight.off", "bend"), ("genus3 twisted (genus 3)", "genus3.off", "twist"),
+            ("3holes shuffled (genus 3)", "3holes.off", "shuffle")]
     diff = [("face ↔ hand", "face.off", "hand_lowres.obj"), ("face ↔ demosthenes", "face.off", "demosthenes-low-res.obj"),
             ("demosthenes ↔ camelhead", "demosthenes-low-res.obj", "camelhead.off"),
             ("cow ↔ horse (closed)", "cow.off", "horse.off"),
@@ -158,7 +179,12 @@ def main():
             V, F = mm.load_mesh(s)
             perm = np.loadtxt(gt, dtype=np.int64)
             fs = features(V.astype(float), F, k)
-            rows.append((name, s, t, [(f, perm[f]) for f in fs], gt))
+            anchors = []
+            if "genus" in name:
+                used = np.concatenate(fs)
+                far = int(np.min(np.linalg.norm(V[:, None, :] - V[None, used, :], axis=2), axis=1).argmax())
+                anchors = [[far, int(perm[far])]]
+            rows.append((name, s, t, [(f, perm[f]) for f in fs], gt, anchors))
         for name, a, b in diff:
             if filt not in name:
                 continue
@@ -169,10 +195,15 @@ def main():
                 fs, ft = head_features(a, VS.astype(float), FS), head_features(b, VT.astype(float), FT)
             else:
                 fs, ft = features(VS.astype(float), FS, k), features(VT.astype(float), FT, k)
-            rows.append((name, s, t, list(zip(fs, ft)), None))
-        for name, s, t, feats, gt in rows:
+            rows.append((name, s, t, list(zip(fs, ft)), None, []))
+        for name, s, t, feats, gt, anchors in rows:
             nv = f"{len(mm.load_mesh(s)[0])}/{len(mm.load_mesh(t)[0])}"
-            e = run(binary, tmp, s, t, feats, [], gt)
+            if "genus" in name:
+                g = int(name.split("genus ")[1].rstrip(")"))
+                e, cls = run_classes(binary, tmp, s, t, feats, anchors, gt, g)
+                name = f"{name}, class {cls}"
+            else:
+                e = run(binary, tmp, s, t, feats, anchors, gt)
             if "error" in e:
                 print(f"| {name} | {nv} | {len(feats)} | — | — | — | — | — | — | — | — | {e['error']} |")
                 continue

@@ -19,7 +19,7 @@
 
 use super::cut::{CutMesh, cut_along, path_edges};
 use super::refine::Refined;
-use super::search::{interior_path, nonseparating_loops};
+use super::search::{each_nonseparating_loop, interior_path};
 use super::word::{Letter, canonical_rotation, canonical_rotations, intersection_matrix, read_word};
 use crate::error::{Error, InputError, Result};
 use crate::mesh::{Mesh, VertexId};
@@ -94,6 +94,22 @@ impl CanonicalBasisResult {
 /// `InvalidInput` for a mesh with boundary or genus 0 (no basis), or when no disjoint basis
 /// is found within the allowed refinement; `Internal` when a certificate fails.
 pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions) -> Result<CanonicalBasisResult> {
+    Ok(canonical_basis_avoiding(mesh, base, opts, &[])?.0)
+}
+
+/// [`canonical_basis`] with loops that keep off the vertices of `avoid` (feature curves, vertex
+/// paths of `mesh`): they are walls for every search, like the boundary of the surface cut so
+/// far. Returns the basis and the curves on its refinement (edges split by a refinement step are
+/// followed through their midpoints).
+///
+/// # Errors
+/// As [`canonical_basis`]; `InvalidInput` when `base` lies on a curve.
+pub fn canonical_basis_avoiding(
+    mesh: &Mesh,
+    base: VertexId,
+    opts: &CanonicalBasisOptions,
+    avoid: &[Vec<VertexId>],
+) -> Result<(CanonicalBasisResult, Loops)> {
     let s = topology::summary(mesh);
     if s.boundary_loops != 0 {
         return Err(InputError::Invalid(
@@ -107,17 +123,26 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
     if base.idx() >= mesh.n_vertices() {
         return Err(InputError::OutOfRange { what: "base vertex", index: base.idx(), count: mesh.n_vertices() }.into());
     }
+    if avoid.iter().flatten().any(|&v| v == base) {
+        return Err(
+            InputError::Invalid(format!("canonical basis: base vertex {} lies on a feature curve", base.0)).into()
+        );
+    }
     let g = s.genus as usize;
-    let mut refined = Refined::identity(mesh).raise_valence(base, 8 * g + 8)?;
+    let mut refined = Refined::identity(mesh);
+    let mut curves = avoid.to_vec();
+    refine_with(&mut refined, &mut curves, |r| r.raise_valence(base, 8 * g + 8))?;
     for round in 0..=opts.max_subdivisions {
         // A crowded base vertex first gets more edges (twice, then four times as many); loops
         // that pen the corner in (neighbouring loop vertices joined by an edge) get those
         // edges split, which opens an interior vertex between them.
         let mut local = refined.clone();
+        let mut local_curves = curves.clone();
         for extra in 0..ATTEMPTS_PER_ROUND {
             let attempt = round * ATTEMPTS_PER_ROUND + extra;
             let t0 = std::time::Instant::now();
-            let res = search(&local.mesh, base, g, opts.basis_index)?;
+            let blocked = blocked_by(&local.mesh, &local_curves);
+            let res = search(&local.mesh, &blocked, base, g, opts.basis_index)?;
             debug(|| {
                 format!(
                     "attempt round {round} extra {extra}: {} vertices, {:.2} s, {}",
@@ -127,7 +152,9 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
                 )
             });
             let partial = match res {
-                Ok(loops) if attempt >= opts.min_attempt => return finish(local, base, loops, round, attempt),
+                Ok(loops) if attempt >= opts.min_attempt => {
+                    return finish(local, base, loops, local_curves, round, attempt);
+                }
                 Ok(loops) | Err(loops) => loops,
             };
             // Loops that pen a corner in leave no vertex between them: split every edge at
@@ -138,14 +165,14 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
             let mut partial = partial;
             for &step in REFINE_STEPS[extra.min(REFINE_STEPS.len() - 1)] {
                 let before = local.mesh.clone();
-                local = match step {
-                    Step::Band => local.split_edges(&band_of(&local.mesh, &partial, base))?,
-                    Step::Chords => local.split_edges(&chords_of(&local.mesh, &partial))?,
+                refine_with(&mut local, &mut local_curves, |r| match step {
+                    Step::Band => r.split_edges(&band_of(&r.mesh, &partial, base)),
+                    Step::Chords => r.split_edges(&chords_of(&r.mesh, &partial)),
                     Step::Valence => {
-                        let valence = local.mesh.outgoing(base).count();
-                        local.raise_valence(base, 2 * valence)?
+                        let valence = r.mesh.outgoing(base).count();
+                        r.raise_valence(base, 2 * valence)
                     }
-                };
+                })?;
                 match rethread(&before, &local.mesh, &partial) {
                     Some(p) => partial = p,
                     None => break,
@@ -153,7 +180,7 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
             }
         }
         if round < opts.max_subdivisions {
-            refined = refined.subdivide()?.raise_valence(base, 8 * g + 8)?;
+            refine_with(&mut refined, &mut curves, |r| r.subdivide()?.raise_valence(base, 8 * g + 8))?;
         }
     }
     Err(InputError::Invalid(format!(
@@ -165,8 +192,39 @@ pub fn canonical_basis(mesh: &Mesh, base: VertexId, opts: &CanonicalBasisOptions
     .into())
 }
 
+/// Applies one refinement to `r` and follows `curves` through it.
+///
+/// # Errors
+/// As the refinement; `Internal` when a curve cannot be followed (a split off the midpoint).
+fn refine_with(r: &mut Refined, curves: &mut Loops, step: impl FnOnce(&Refined) -> Result<Refined>) -> Result<()> {
+    let next = step(r)?;
+    if !curves.is_empty() {
+        *curves = rethread(&r.mesh, &next.mesh, curves)
+            .ok_or_else(|| Error::Internal("canonical basis: a feature curve lost its edges in a refinement".into()))?;
+    }
+    *r = next;
+    Ok(())
+}
+
+/// Per vertex of `mesh`: on one of `curves` (empty without curves).
+fn blocked_by(mesh: &Mesh, curves: &[Vec<VertexId>]) -> Vec<bool> {
+    if curves.is_empty() {
+        return Vec::new();
+    }
+    let mut b = vec![false; mesh.n_vertices()];
+    for v in curves.iter().flatten() {
+        b[v.idx()] = true;
+    }
+    b
+}
+
+/// `blocked` (per vertex of the uncut mesh) per vertex of `s`.
+fn blocked_on(s: &CutMesh, blocked: &[bool]) -> Vec<bool> {
+    if blocked.is_empty() { Vec::new() } else { s.orig.iter().map(|o| blocked[o.idx()]).collect() }
+}
+
 /// Searches per subdivision round (each failed one refines before the next).
-const ATTEMPTS_PER_ROUND: usize = 6;
+pub(crate) const ATTEMPTS_PER_ROUND: usize = 6;
 
 /// One local refinement around the loops found by a stuck search.
 #[derive(Debug, Clone, Copy)]
@@ -192,28 +250,40 @@ const REFINE_STEPS: [&[Step]; 6] = [
 /// Handle by handle on the surface cut so far; `None` when loops would have to touch.
 /// Each handle tries the corners between commutators (most reachable interior first) and, at
 /// each, the shortest few non-separating classes, until one admits its crossing loop.
-fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<std::result::Result<Loops, Loops>> {
+fn search(
+    mesh: &Mesh,
+    blocked: &[bool],
+    base: VertexId,
+    g: usize,
+    first: usize,
+) -> Result<std::result::Result<Loops, Loops>> {
     let mut s = CutMesh { mesh: mesh.clone(), orig: (0..mesh.n_vertices()).map(VertexId::from_idx).collect() };
+    let mut walls = blocked.to_vec();
     let mut corners = vec![base];
     let mut loops: Vec<Vec<VertexId>> = Vec::with_capacity(2 * g);
     for handle in 0..g {
         let mut done = None;
         'corners: for &corner in &corners {
             let (skip, count) = if handle == 0 { (first, first + 1) } else { (0, 3) };
-            let cands = nonseparating_loops(&s.mesh, corner, count)?;
-            let n_cands = cands.len();
-            for a in cands.into_iter().skip(skip) {
-                if let Some(step) = cross(&s, corner, &a, handle == 0)? {
-                    done = Some(step);
-                    break 'corners;
+            // Candidates one at a time: the first that admits its crossing loop ends the search.
+            let mut seen = 0;
+            let n_cands = each_nonseparating_loop(&s.mesh, &walls, corner, count, &mut |a| {
+                seen += 1;
+                if seen <= skip {
+                    return Ok(false);
                 }
+                done = cross(&s, blocked, corner, &a, handle == 0)?;
+                Ok(done.is_some())
+            })?;
+            if done.is_some() {
+                break 'corners;
             }
             debug(|| {
                 format!(
                     "handle {handle}: no loop pair at corner {} ({n_cands} loops, fan {}, interior {})",
                     corner.0,
                     s.mesh.outgoing(corner).count(),
-                    interior_components(&s.mesh)(corner)
+                    interior_components(&s.mesh, &walls)(corner)
                 )
             });
         }
@@ -231,10 +301,12 @@ fn search(mesh: &Mesh, base: VertexId, g: usize, first: usize) -> Result<std::re
             return Err(Error::Internal(format!("basis: handle {} left a non-canonical word", handle + 1)));
         }
         {
-            let reach = interior_components(&s2.mesh);
+            let w2 = blocked_on(&s2, blocked);
+            let reach = interior_components(&s2.mesh, &w2);
             corners
                 .sort_by_key(|&c| std::cmp::Reverse((reach(c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0))));
         }
+        walls = blocked_on(&s2, blocked);
         s = s2;
     }
     Ok(Ok(loops))
@@ -295,12 +367,14 @@ fn chords_of(mesh: &Mesh, loops: &[Vec<VertexId>]) -> Vec<[VertexId; 2]> {
         .collect()
 }
 
-/// Cuts `a` (a loop at `corner` of `s`) and looks for `b` from one side of it to the other.
+/// Cuts `a` (a loop at `corner` of `s`) and looks for `b` from one side of it to the other,
+/// keeping off `blocked` (per vertex of the uncut mesh).
 /// Returns `a`, `b` (in the ids of `s` and of the intermediate cut), that cut's `orig`, and the
 /// surface cut along both.
 #[allow(clippy::type_complexity)]
 fn cross(
     s: &CutMesh,
+    blocked: &[bool],
     corner: VertexId,
     a: &[VertexId],
     interior: bool,
@@ -322,20 +396,21 @@ fn cross(
     let to: Vec<VertexId> = local.iter().copied().filter(|&c| c != from).collect();
     let on_a: std::collections::HashSet<VertexId> = a.iter().copied().collect();
     let on_new = |w: VertexId| s1_local(&s1, s, w).is_some_and(|x| on_a.contains(&x));
-    let Some(b) = interior_path(&s1.mesh, from, &to, &on_new) else { return Ok(None) };
+    let Some(b) = interior_path(&s1.mesh, &blocked_on(&s1, blocked), from, &to, &on_new) else { return Ok(None) };
     let s2 = compose(&s1, cut_along(&s1.mesh, &path_edges(&s1.mesh, std::slice::from_ref(&b))?)?);
     Ok(Some((a.to_vec(), b, s1.orig, s2)))
 }
 
 /// For any vertex: how many interior vertices its interior neighbours reach through interior
 /// vertices (one labelling of the interior's components serves every corner).
-fn interior_components(mesh: &Mesh) -> impl Fn(VertexId) -> usize + '_ {
+fn interior_components<'a>(mesh: &'a Mesh, blocked: &[bool]) -> impl Fn(VertexId) -> usize + 'a {
+    let wall = |v: VertexId| super::search::wall(mesh, blocked, v);
     let n = mesh.n_vertices();
     let mut comp = vec![u32::MAX; n];
     let mut size: Vec<usize> = Vec::new();
     for v0 in 0..n {
         let v0 = VertexId::from_idx(v0);
-        if comp[v0.idx()] != u32::MAX || mesh.is_boundary_vertex(v0) {
+        if comp[v0.idx()] != u32::MAX || wall(v0) {
             continue;
         }
         let id = size.len() as u32;
@@ -345,7 +420,7 @@ fn interior_components(mesh: &Mesh) -> impl Fn(VertexId) -> usize + '_ {
         while let Some(v) = stack.pop() {
             count += 1;
             for w in mesh.vertex_neighbors(v) {
-                if comp[w.idx()] == u32::MAX && !mesh.is_boundary_vertex(w) {
+                if comp[w.idx()] == u32::MAX && !wall(w) {
                     comp[w.idx()] = id;
                     stack.push(w);
                 }
@@ -403,9 +478,10 @@ fn finish(
     refined: Refined,
     base: VertexId,
     loops: Vec<Vec<VertexId>>,
+    mut curves: Loops,
     subdivisions: usize,
     attempt: usize,
-) -> Result<CanonicalBasisResult> {
+) -> Result<(CanonicalBasisResult, Loops)> {
     let on_cut = {
         let mut f = vec![false; refined.mesh.n_vertices()];
         for l in &loops {
@@ -421,7 +497,8 @@ fn finish(
         .map(|e| refined.mesh.edge_vertices(crate::mesh::EdgeId::from_idx(e)))
         .filter(|[a, b]| on_cut[a.idx()] && on_cut[b.idx()])
         .collect();
-    let refined = refined.split_edges(&chords)?;
+    let mut refined = refined;
+    refine_with(&mut refined, &mut curves, |r| r.split_edges(&chords))?;
     let disk = cut_along(&refined.mesh, &path_edges(&refined.mesh, &loops)?)?;
     let chi = topology::euler_characteristic(&disk.mesh);
     let w = read_word(&disk.mesh, &disk.orig, base, &loops)
@@ -453,7 +530,7 @@ fn finish(
     let word: Vec<Letter> = (0..n).map(|i| w2.letters[(r2 + i) % n]).collect();
     let corners: Vec<usize> = (0..m).filter(|&i| disk.orig[walk[i].idx()] == base).collect();
     let intersection = intersection_matrix(&refined.mesh, base, &labeled);
-    Ok(CanonicalBasisResult {
+    let basis = CanonicalBasisResult {
         refined,
         base,
         loops: labeled,
@@ -464,7 +541,8 @@ fn finish(
         word,
         subdivisions,
         attempt,
-    })
+    };
+    Ok((basis, curves))
 }
 
 /// Prints what `msg` says under `SURFMAP_DEBUG` (built only then).
@@ -495,6 +573,26 @@ mod tests {
                 assert!(l[1..l.len() - 1].iter().all(|v| seen.insert(*v)));
             }
         }
+    }
+
+    /// A curve across the torus's outer equator: the loops keep off it (it is a wall), the basis
+    /// stays canonical, and a base on the curve is refused.
+    #[test]
+    fn the_basis_keeps_off_curves() {
+        let t = shapes::torus(24, 12, 1.0, 0.3);
+        let free = canonical_basis(&t, VertexId(0), &CanonicalBasisOptions::default()).unwrap();
+        // Vertices of the first loop away from the base: a wall the unconstrained basis crosses.
+        let l = &free.loops[0];
+        let curve: Vec<VertexId> = l[l.len() / 2 - 1..=l.len() / 2 + 1].to_vec();
+        let o = CanonicalBasisOptions::default();
+        let (r, moved) = canonical_basis_avoiding(&t, VertexId(0), &o, std::slice::from_ref(&curve)).unwrap();
+        assert_eq!(r.word_text(), "a1 b1 a1^-1 b1^-1");
+        assert_eq!(r.intersection, vec![vec![0, 1], vec![-1, 0]]);
+        assert_eq!(topology::euler_characteristic(&r.disk.mesh), 1);
+        assert_eq!(moved.len(), 1);
+        assert!(r.loops.iter().flatten().all(|v| !moved[0].contains(v)), "a loop runs through the curve");
+        let on = canonical_basis_avoiding(&t, curve[1], &o, std::slice::from_ref(&curve)).unwrap_err();
+        assert!(on.is_input(), "{on}");
     }
 
     #[test]

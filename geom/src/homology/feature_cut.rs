@@ -31,6 +31,9 @@ pub enum SideKind {
     Link(usize),
     /// Curve `i` (open feature or boundary arc).
     Curve(usize),
+    /// Side `i` of the canonical 4g-gon, counted from the corner the chain arrives at (surfaces
+    /// with handles, [`super::feature_handles`]).
+    Basis(usize),
 }
 
 /// One side: `walk[start..=start + edges]` (cyclically).
@@ -76,6 +79,22 @@ pub fn feature_cut(
     order: &[(usize, bool)],
     anchor: Option<VertexId>,
     loop_start: Option<VertexId>,
+) -> Result<FeatureCutResult> {
+    match cut_with(mesh, curves, order, anchor, loop_start, false) {
+        Err(Error::Input(InputError::Features(_))) => cut_with(mesh, curves, order, anchor, loop_start, true),
+        r => r,
+    }
+}
+
+/// [`feature_cut`] with shortest links, or with links that keep clear of used vertices
+/// (`clear`, see [`link_path`]).
+fn cut_with(
+    mesh: &Mesh,
+    curves: &[Curve],
+    order: &[(usize, bool)],
+    anchor: Option<VertexId>,
+    loop_start: Option<VertexId>,
+    clear: bool,
 ) -> Result<FeatureCutResult> {
     let s = topology::summary(mesh);
     if s.genus != 0 {
@@ -164,7 +183,7 @@ pub fn feature_cut(
         let entry = match prev {
             None => entry_targets[0],
             Some(p) => {
-                let link = link_path(mesh, &used, p, &entry_targets).ok_or_else(|| {
+                let link = link_path(mesh, &used, p, &entry_targets, clear).ok_or_else(|| {
                     InputError::Features(format!(
                         "no path from vertex {} to curve {i} avoids the other curves; refine the mesh or move the curves apart",
                         p.0
@@ -248,13 +267,67 @@ pub fn chain_order(meshes: [&Mesh; 2], curves: [&[Curve]; 2]) -> Vec<(usize, boo
     order
 }
 
-/// Shortest path from `from` to one of `to` through unused vertices only.
-fn link_path(mesh: &Mesh, used: &[bool], from: VertexId, to: &[VertexId]) -> Option<Vec<VertexId>> {
+/// The chain's order on surfaces with handles, where the chain ends at the base (at a corner of
+/// the 4g-gon): greedy nearest-neighbour outward from `base` on each mesh (distances as in
+/// [`chain_order`]), then walked backwards, so that the last curve is the one nearest the base
+/// and is left at its nearer end. The link to the base is then short and direct; a long one
+/// that has to pass the chain of curves on one side or the other can take different sides on
+/// two deformed copies (the whole chain then turns once around the base).
+pub fn chain_order_to_base(meshes: [&Mesh; 2], curves: [&[Curve]; 2], base: [VertexId; 2]) -> Vec<(usize, bool)> {
+    let end = |k: usize, i: usize, last: bool| {
+        let v = &curves[k][i].vertices;
+        meshes[k].position(if last { v[v.len() - 1] } else { v[0] })
+    };
+    let scale = |k: usize| meshes[k].bbox_diagonal().max(f64::MIN_POSITIVE);
+    let mut left: Vec<usize> = (0..curves[0].len()).collect();
+    let mut out: Vec<(usize, bool)> = Vec::with_capacity(left.len());
+    while !left.is_empty() {
+        // From the base, then from the far end of the curve taken last.
+        let from = |k: usize| match out.last() {
+            None => meshes[k].position(base[k]),
+            Some(&(i, entered_at_last)) => end(k, i, !entered_at_last),
+        };
+        let mut best = (f64::INFINITY, 0, false);
+        for (j, &c) in left.iter().enumerate() {
+            for r in [false, true] {
+                let d: f64 = (0..2).map(|k| (from(k) - end(k, c, r)).norm() / scale(k)).sum();
+                if d < best.0 {
+                    best = (d, j, r);
+                }
+            }
+        }
+        out.push((left.remove(best.1), best.2));
+    }
+    out.into_iter().rev().map(|(c, r)| (c, !r)).collect()
+}
+
+/// Shortest path from `from` to one of `to` through unused vertices only. With `clear`, the
+/// path first keeps a vertex of clearance from every used vertex (away from its own two ends):
+/// a link that comes next to used vertices twice pens the vertices between in a pocket that
+/// later links cannot enter (vertex walls block passage wherever two of them share an edge);
+/// when that finds nothing, steps next to used vertices only cost more.
+fn link_path(mesh: &Mesh, used: &[bool], from: VertexId, to: &[VertexId], clear: bool) -> Option<Vec<VertexId>> {
     let is_target = |v: VertexId| to.contains(&v);
     let allowed = |v: VertexId| is_target(v) || !used[v.idx()];
-    let (tree, hit) = search::dijkstra(mesh, &[from], &allowed, &|_| true, &is_target, &|_| 1.0);
+    if !clear {
+        let (tree, hit) = search::dijkstra(mesh, &[from], &allowed, &|_| true, &is_target, &|_| 1.0);
+        return Some(search::path_to(&tree, hit?));
+    }
+    let at_end = |v: VertexId| v == from || is_target(v);
+    let near = |v: VertexId| !at_end(v) && mesh.vertex_neighbors(v).any(|w| used[w.idx()] && !at_end(w));
+    let end_ring = |v: VertexId| mesh.vertex_neighbors(v).any(at_end);
+    let strict = |v: VertexId| is_target(v) || (!used[v.idx()] && (!near(v) || end_ring(v)));
+    let (tree, hit) = search::dijkstra(mesh, &[from], &strict, &|_| true, &is_target, &|_| 1.0);
+    if let Some(h) = hit {
+        return Some(search::path_to(&tree, h));
+    }
+    let weight = |v: VertexId| if near(v) { LINK_CLEARANCE } else { 1.0 };
+    let (tree, hit) = search::dijkstra(mesh, &[from], &allowed, &|_| true, &is_target, &weight);
     Some(search::path_to(&tree, hit?))
 }
+
+/// Cost factor of a link step onto a vertex next to a used one (when no path keeps clear).
+const LINK_CLEARANCE: f64 = 3.0;
 
 /// The vertex of a boundary loop halfway round from its start, by arc length.
 fn half_way(mesh: &Mesh, ring: &[VertexId]) -> VertexId {

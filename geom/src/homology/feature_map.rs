@@ -1,5 +1,6 @@
-//! Maps between two genus-0 surfaces that carry corresponding feature curves (boundary loops
-//! included): both cut by [`feature_cut`], both mapped onto the unit circle with the same arcs
+//! Maps between two surfaces that carry corresponding feature curves (boundary loops included
+//! on genus 0): both cut by [`feature_cut`] (through the canonical basis on surfaces with
+//! handles, [`super::feature_handles`]), both mapped onto the unit circle with the same arcs
 //! ([`feature_domain`]), composed both ways. Every feature lands on its partner exactly (both
 //! are the same arc of the circle), and the composition of two bijections is one.
 
@@ -7,7 +8,9 @@ use super::compose::{Planar, locate_all, warp_interior};
 use super::curve_align::{CurveAlignOptions, align_fractions, arc_fractions, loop_rotation};
 use super::feature_cut::{FeatureCutResult, chain_order, feature_cut};
 use super::feature_domain::{FeatureDomainResult, feature_domain, shared_arcs};
+use super::feature_handles::{HandleCutOptions, HandleCuts, handle_cuts};
 use super::features::{Curve, CurveKind};
+use super::refine::Refined;
 use crate::error::{InputError, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, P3, VertexId};
@@ -17,11 +20,18 @@ use crate::mesh::{Mesh, P3, VertexId};
 pub struct FeatureSide {
     pub cut: FeatureCutResult,
     pub domain: FeatureDomainResult,
+    /// The refinement the cut lives on (surfaces with handles); `None`: the mesh itself.
+    pub refined: Option<Refined>,
 }
 
 impl FeatureSide {
     pub fn planar(&self) -> Planar<'_> {
-        Planar { disk: &self.cut.disk, uv: &self.domain.uv, refined: None }
+        Planar { disk: &self.cut.disk, uv: &self.domain.uv, refined: self.refined.as_ref() }
+    }
+
+    /// The mesh the cut's vertex ids refer to: the refinement, or `mesh` itself.
+    pub fn cut_mesh<'a>(&'a self, mesh: &'a Mesh) -> &'a Mesh {
+        self.refined.as_ref().map_or(mesh, |r| &r.mesh)
     }
 }
 
@@ -34,6 +44,11 @@ pub struct FeatureMapOptions {
     /// ([`super::curve_align`]) and turn an unlisted boundary loop to match; `None` places both
     /// by arc length from their own chain arrivals.
     pub align: Option<CurveAlignOptions>,
+    /// Surfaces with handles: basis index on each mesh, rotation τ and subdivision rounds, as in
+    /// [`super::map::HomologyMapOptions`]; the first anchor pair is the base.
+    pub basis: [usize; 2],
+    pub rotation: usize,
+    pub max_subdivisions: Option<usize>,
 }
 
 /// Maps both ways and what produced them.
@@ -47,6 +62,8 @@ pub struct FeatureMapResult {
     pub target: FeatureSide,
     /// The chain's order: given curve index, entered at its last vertex.
     pub order: Vec<(usize, bool)>,
+    /// The canonical bases, on surfaces with handles.
+    pub handles: Option<HandleCuts>,
 }
 
 /// Maps `source` onto `target` so that `source_curves[i]` lands on `target_curves[i]`.
@@ -82,6 +99,34 @@ pub fn feature_map(
             .into());
         }
     }
+    let genus = crate::topology::summary(source).genus;
+    if genus != crate::topology::summary(target).genus {
+        return Err(InputError::TopologyMismatch(format!(
+            "source genus {genus}, target genus {}",
+            crate::topology::summary(target).genus
+        ))
+        .into());
+    }
+    if genus > 0 {
+        let &(bs, bt) = anchors.first().ok_or_else(|| {
+            InputError::Anchors(
+                "a surface with handles needs an anchor pair: the first is the basis's base vertex".into(),
+            )
+        })?;
+        if source_curves.iter().any(|c| c.vertices.contains(&bs))
+            || target_curves.iter().any(|c| c.vertices.contains(&bt))
+        {
+            return Err(InputError::Anchors(format!(
+                "the first anchor pair ({}, {}) is the base vertex of both canonical bases and must not lie on a feature curve",
+                bs.0, bt.0
+            ))
+            .into());
+        }
+        let ho = HandleCutOptions { basis: o.basis, rotation: o.rotation, max_subdivisions: o.max_subdivisions };
+        let h = handle_cuts([source, target], [source_curves, target_curves], [bs, bt], &ho)?;
+        let refined = [Some(h.handles.source.refined.clone()), Some(h.handles.target.refined.clone())];
+        return compose_cuts(source, target, h.source, h.target, h.order, refined, Some(h.handles), anchors, o);
+    }
     let order = chain_order([source, target], [source_curves, target_curves]);
     // The first anchor pair with both ends on the boundary starts an unlisted boundary loop.
     let on_boundary = anchors.iter().find(|(a, b)| source.is_boundary_vertex(*a) && target.is_boundary_vertex(*b));
@@ -104,6 +149,26 @@ pub fn feature_map(
             tc = feature_cut(target, target_curves, &order, interior.map(|a| a.1), Some(tl[r]))?;
         }
     }
+    compose_cuts(source, target, sc, tc, order, [None, None], None, anchors, o)
+}
+
+/// Both cuts on the circle with shared arcs (the target's curve sides aligned to the source's),
+/// the anchor warp, and the maps both ways.
+///
+/// # Errors
+/// As [`feature_domain`] and [`warp_interior`].
+#[allow(clippy::too_many_arguments)]
+fn compose_cuts(
+    source: &Mesh,
+    target: &Mesh,
+    sc: FeatureCutResult,
+    tc: FeatureCutResult,
+    order: Vec<(usize, bool)>,
+    refined: [Option<Refined>; 2],
+    handles: Option<HandleCuts>,
+    anchors: &[(VertexId, VertexId)],
+    o: &FeatureMapOptions,
+) -> Result<FeatureMapResult> {
     let arcs = shared_arcs(&sc, &tc)?;
     let it = o.stretch_iterations;
     let tf = match &o.align {
@@ -111,8 +176,9 @@ pub fn feature_map(
         None => arc_fractions(&tc),
     };
     let (sd, td) = (feature_domain(&sc, &arcs, &arc_fractions(&sc), it)?, feature_domain(&tc, &arcs, &tf, it)?);
-    let mut s = FeatureSide { cut: sc, domain: sd };
-    let t = FeatureSide { cut: tc, domain: td };
+    let [rs, rt] = refined;
+    let mut s = FeatureSide { cut: sc, domain: sd, refined: rs };
+    let t = FeatureSide { cut: tc, domain: td, refined: rt };
     let id = |p| p;
     let warped = warp_interior(&s.cut.disk, &mut s.domain.uv, &s.cut.walk, &t.planar(), anchors, &id)?;
     if warped {
@@ -122,7 +188,7 @@ pub fn feature_map(
     let mut target_to_source = locate_all(target.n_vertices(), &t.planar(), &s.planar(), &id);
     snap_boundary(&mut source_to_target, &s, &t, target)?;
     snap_boundary(&mut target_to_source, &t, &s, source)?;
-    Ok(FeatureMapResult { source_to_target, target_to_source, warped, source: s, target: t, order })
+    Ok(FeatureMapResult { source_to_target, target_to_source, warped, source: s, target: t, order, handles })
 }
 
 /// Angle of a point of the circle in `[0, 2π)`.
@@ -141,13 +207,15 @@ pub(crate) fn angle(p: [f64; 2]) -> f64 {
 /// # Errors
 /// `Internal` when a boundary edge of the disk is no edge of the mesh.
 fn snap_boundary(map: &mut SurfaceMap, from: &FeatureSide, to: &FeatureSide, to_mesh: &Mesh) -> Result<()> {
+    let to_mesh = to.cut_mesh(to_mesh);
     let walk = &to.cut.walk;
     let th: Vec<f64> = walk.iter().map(|v| angle(to.domain.uv[v.idx()])).collect();
     let disk = &from.cut.disk;
     let mut done = vec![false; map.face.len()];
     for &v in &from.cut.walk {
         let o = disk.orig[v.idx()];
-        if std::mem::replace(&mut done[o.idx()], true) {
+        // Vertices a refinement added are no vertices of the mesh the map is for.
+        if o.idx() >= done.len() || std::mem::replace(&mut done[o.idx()], true) {
             continue;
         }
         let a = angle(from.domain.uv[v.idx()]);
@@ -169,6 +237,10 @@ fn snap_boundary(map: &mut SurfaceMap, from: &FeatureSide, to: &FeatureSide, to_
                 b[k] += u;
             }
         }
+        let (f, b) = match &to.refined {
+            Some(r) => r.to_original(f, b),
+            None => (f, b),
+        };
         map.face[o.idx()] = f;
         map.bary[o.idx()] = b;
     }

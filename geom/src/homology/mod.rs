@@ -17,6 +17,7 @@
 //! - [`features`]: feature curves (boundary loops included), the double cover they define.
 //! - [`feature_cut`]: a genus-0 surface cut open so that every feature lies on the boundary.
 //! - [`feature_domain`]: that disk on the unit circle, arcs shared by both meshes.
+//! - [`feature_handles`]: the same cut on a surface with handles (basis loops around the curves).
 //! - [`feature_map`]: maps both ways that take every feature onto its partner.
 
 pub mod basis;
@@ -28,6 +29,7 @@ pub mod cut;
 pub mod domain;
 pub mod feature_cut;
 pub mod feature_domain;
+pub mod feature_handles;
 pub mod feature_map;
 pub mod feature_overlay;
 pub mod features;

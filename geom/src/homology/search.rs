@@ -33,13 +33,19 @@ const CLEARANCE: f64 = 3.0;
 /// Classes tried beyond the number of loops asked for.
 const MAX_EXTRA_CLASSES: usize = 3;
 
-/// Interior vertices with a boundary neighbour other than `except`.
-fn near_boundary(mesh: &Mesh, except: &[VertexId]) -> Vec<bool> {
+/// Whether paths must keep off `v`: a boundary vertex, or one `blocked` lists (per vertex of
+/// `mesh`; feature curves the basis must not touch, see [`super::basis::canonical_basis_avoiding`]).
+/// An empty `blocked` blocks nothing.
+pub(super) fn wall(mesh: &Mesh, blocked: &[bool], v: VertexId) -> bool {
+    mesh.is_boundary_vertex(v) || blocked.get(v.idx()).copied().unwrap_or(false)
+}
+
+/// Free vertices with a wall neighbour other than `except`.
+fn near_boundary(mesh: &Mesh, blocked: &[bool], except: &[VertexId]) -> Vec<bool> {
     (0..mesh.n_vertices())
         .map(|v| {
             let v = VertexId::from_idx(v);
-            !mesh.is_boundary_vertex(v)
-                && mesh.vertex_neighbors(v).any(|w| mesh.is_boundary_vertex(w) && !except.contains(&w))
+            !wall(mesh, blocked, v) && mesh.vertex_neighbors(v).any(|w| wall(mesh, blocked, w) && !except.contains(&w))
         })
         .collect()
 }
@@ -109,7 +115,7 @@ pub(super) fn path_to(t: &Tree, v: VertexId) -> Vec<VertexId> {
 /// Simple non-separating loops through `corner` (a vertex of `mesh`, interior or on its one
 /// boundary loop) avoiding the boundary elsewhere, one per Z2 homology class, classes ordered
 /// by their shortest (tree) loop, at most `count`. Each is a vertex list from `corner` back to
-/// `corner`.
+/// `corner`. Vertices `blocked` lists (per vertex of `mesh`) are walls like the boundary.
 ///
 /// A shortest loop through a vertex far from its handle is a lasso: a stem walked out and back
 /// plus a cycle. Such a loop cannot be cut as an edge path, so the stem is slit open first and
@@ -118,15 +124,41 @@ pub(super) fn path_to(t: &Tree, v: VertexId) -> Vec<VertexId> {
 ///
 /// # Errors
 /// `Internal` from the cohomology construction.
-pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Result<Vec<Vec<VertexId>>> {
-    let allowed = |v: VertexId| v == corner || !mesh.is_boundary_vertex(v);
+pub fn nonseparating_loops(
+    mesh: &Mesh,
+    blocked: &[bool],
+    corner: VertexId,
+    count: usize,
+) -> Result<Vec<Vec<VertexId>>> {
+    let mut out = Vec::new();
+    each_nonseparating_loop(mesh, blocked, corner, count, &mut |lp| {
+        out.push(lp);
+        Ok(false)
+    })?;
+    Ok(out)
+}
+
+/// [`nonseparating_loops`] handed to `take` one at a time, in order, until it returns `true`:
+/// a caller that accepts the first loop does not pay for the later ones (each may cost a slit
+/// surface and a two-branch search). Returns how many were handed over.
+///
+/// # Errors
+/// As [`nonseparating_loops`], and whatever `take` returns.
+pub fn each_nonseparating_loop(
+    mesh: &Mesh,
+    blocked: &[bool],
+    corner: VertexId,
+    count: usize,
+    take: &mut dyn FnMut(Vec<VertexId>) -> Result<bool>,
+) -> Result<usize> {
+    let allowed = |v: VertexId| v == corner || !wall(mesh, blocked, v);
     // At a boundary corner, keep the neighbours next to the boundary edges free of first
     // steps, so that the crossing path has a side to arrive on.
     let fan: Vec<VertexId> = mesh.vertex_neighbors(corner).collect();
     let hugging: Vec<VertexId> =
         if mesh.is_boundary_vertex(corner) && fan.len() >= 4 { vec![fan[1], fan[fan.len() - 2]] } else { Vec::new() };
     let first_ok = |w: VertexId| !hugging.contains(&w);
-    let near = near_boundary(mesh, &[corner]);
+    let near = near_boundary(mesh, blocked, &[corner]);
     // At a boundary corner, leaving near the middle of its fan keeps the outer sectors wide:
     // they become the corners of the next handles.
     let mut fan_cost = vec![1.0; mesh.n_vertices()];
@@ -175,11 +207,11 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
     }
     lassos.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let mut seen = std::collections::HashSet::new();
-    let mut out = Vec::new();
+    let mut out = 0;
     for (_, e) in lassos {
         // Classes beyond the shortest few are long detours; trying them all costs a slit and a
         // search each on a failing corner.
-        if out.len() >= count || seen.len() >= count + MAX_EXTRA_CLASSES {
+        if out >= count || seen.len() >= count + MAX_EXTRA_CLASSES {
             break;
         }
         let want = coh.mask[e.idx()];
@@ -193,17 +225,23 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
             // Tree paths from different first edges: already a simple loop.
             let mut lp = px.clone();
             lp.extend(py.iter().rev());
-            if room_at_corner(mesh, corner, &lp) {
-                out.push(lp);
+            if room_at_corner(mesh, blocked, corner, &lp) {
+                out += 1;
+                if take(lp)? {
+                    return Ok(out);
+                }
                 continue;
             }
         }
         if stem_len >= 2 {
-            let rb = return_beside(mesh, corner, &px, y, &coh.mask, want, &weight);
+            let rb = return_beside(mesh, blocked, corner, &px, y, &coh.mask, want, &weight);
             if let Some(lp) = rb
-                && room_at_corner(mesh, corner, &lp)
+                && room_at_corner(mesh, blocked, corner, &lp)
             {
-                out.push(lp);
+                out += 1;
+                if take(lp)? {
+                    return Ok(out);
+                }
                 continue;
             }
         }
@@ -220,10 +258,17 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
         }
         let corners: Vec<VertexId> =
             (0..slit.mesh.n_vertices()).map(VertexId::from_idx).filter(|v| slit.orig[v.idx()] == corner).collect();
-        let room = |lp: &[VertexId]| room_at_corner(mesh, corner, lp);
+        let room = |lp: &[VertexId]| room_at_corner(mesh, blocked, corner, lp);
         let weight_slit = |w: VertexId| weight(slit.orig[w.idx()]);
-        if let Some(lp) = shortest_simple_loop(&slit, &corners, &emask, want, stem_len >= 2, &weight_slit, &room) {
-            out.push(lp);
+        let blocked_slit: Vec<bool> =
+            if blocked.is_empty() { Vec::new() } else { slit.orig.iter().map(|o| blocked[o.idx()]).collect() };
+        let found =
+            shortest_simple_loop(&slit, &blocked_slit, &corners, &emask, want, stem_len >= 2, &weight_slit, &room);
+        if let Some(lp) = found {
+            out += 1;
+            if take(lp)? {
+                return Ok(out);
+            }
         }
     }
     Ok(out)
@@ -232,8 +277,10 @@ pub fn nonseparating_loops(mesh: &Mesh, corner: VertexId, count: usize) -> Resul
 /// A lasso's loop made simple: out along `out` (corner to `x`), across to `y`, and back to the
 /// corner by the shortest path that avoids `out` (keeping a vertex of clearance from it where it
 /// can), in class `want`.
+#[allow(clippy::too_many_arguments)]
 fn return_beside(
     mesh: &Mesh,
+    blocked: &[bool],
     corner: VertexId,
     out: &[VertexId],
     y: VertexId,
@@ -246,7 +293,7 @@ fn return_beside(
     for v in &out[1..] {
         on_out[v.idx()] = true;
     }
-    if on_out[y.idx()] || mesh.is_boundary_vertex(y) {
+    if on_out[y.idx()] || wall(mesh, blocked, y) {
         return None;
     }
     let mut beside = vec![false; n];
@@ -255,7 +302,7 @@ fn return_beside(
             beside[w.idx()] = true;
         }
     }
-    let allowed = |v: VertexId| v == corner || (!on_out[v.idx()] && !mesh.is_boundary_vertex(v));
+    let allowed = |v: VertexId| v == corner || (!on_out[v.idx()] && !wall(mesh, blocked, v));
     let w8 = |v: VertexId| if beside[v.idx()] && v != corner { CLEARANCE * weight(v) } else { weight(v) };
     let (tree, hit) = dijkstra(mesh, &[y], &allowed, &|_| true, &|v| v == corner, &w8);
     hit?;
@@ -269,8 +316,10 @@ fn return_beside(
 
 /// The shortest loop in class `want` on `slit` from a corner copy back to a corner copy, with
 /// halves that share no vertex; returned in the uncut mesh's vertex ids.
+#[allow(clippy::too_many_arguments)]
 fn shortest_simple_loop(
     slit: &CutMesh,
+    blocked: &[bool],
     corners: &[VertexId],
     mask: &[u64],
     want: u64,
@@ -279,7 +328,7 @@ fn shortest_simple_loop(
     room: &dyn Fn(&[VertexId]) -> bool,
 ) -> Option<Vec<VertexId>> {
     let mesh = &slit.mesh;
-    let two = two_branch_dijkstra(mesh, corners, mask, by_side, weight);
+    let two = two_branch_dijkstra(mesh, blocked, corners, mask, by_side, weight);
     let mut cands: Vec<(f64, u32, u32)> = Vec::new();
     for e in 0..mesh.n_edges() {
         let e = EdgeId::from_idx(e);
@@ -334,7 +383,7 @@ fn shortest_simple_loop(
 /// The loop's two ends at the corner leave a free neighbour (not on the loop, not on the
 /// boundary) between them and, at a boundary corner, outside them on at least one side, so
 /// the path that crosses the loop there can start and end.
-fn room_at_corner(mesh: &Mesh, corner: VertexId, lp: &[VertexId]) -> bool {
+fn room_at_corner(mesh: &Mesh, blocked: &[bool], corner: VertexId, lp: &[VertexId]) -> bool {
     let fan: Vec<VertexId> = mesh.vertex_neighbors(corner).collect();
     let l = lp.len();
     if l < 4 {
@@ -344,7 +393,7 @@ fn room_at_corner(mesh: &Mesh, corner: VertexId, lp: &[VertexId]) -> bool {
         return false;
     };
     let on_loop: std::collections::HashSet<VertexId> = lp.iter().copied().collect();
-    let free = |i: usize| !on_loop.contains(&fan[i]) && !mesh.is_boundary_vertex(fan[i]);
+    let free = |i: usize| !on_loop.contains(&fan[i]) && !wall(mesh, blocked, fan[i]);
     let d = fan.len();
     if mesh.is_boundary_vertex(corner) {
         let (i, j) = (p.min(q), p.max(q));
@@ -433,13 +482,14 @@ fn neighbors_with_edges(mesh: &Mesh, v: VertexId) -> Vec<(VertexId, EdgeId)> {
 /// copies, or the two halves of its one fan; otherwise each first edge is its own branch.
 fn two_branch_dijkstra(
     mesh: &Mesh,
+    blocked: &[bool],
     corners: &[VertexId],
     mask: &[u64],
     by_side: bool,
     weight: &dyn Fn(VertexId) -> f64,
 ) -> TwoBranch {
     let n = mesh.n_vertices();
-    let allowed = |v: VertexId| !corners.contains(&v) && !mesh.is_boundary_vertex(v);
+    let allowed = |v: VertexId| !corners.contains(&v) && !wall(mesh, blocked, v);
     let mut labels: Vec<Label> = Vec::new();
     let mut of: Vec<Vec<u32>> = vec![Vec::new(); n];
     let mut heap = BinaryHeap::new();
@@ -506,22 +556,24 @@ fn two_branch_dijkstra(
     TwoBranch { labels, of, roots }
 }
 
-/// The shortest path from `from` to any of `to` through interior vertices only.
+/// The shortest path from `from` to any of `to` through interior vertices only (`blocked`
+/// ones excepted, as in [`nonseparating_loops`]).
 ///
 /// `on_new(w)` tells the boundary vertices of the loop just cut: a target corner's fan runs from
 /// that loop to older boundary, and arriving near the older boundary would leave a thin wedge
 /// there, which later becomes the corner of the next handle; those steps cost more.
 pub fn interior_path(
     mesh: &Mesh,
+    blocked: &[bool],
     from: VertexId,
     to: &[VertexId],
     on_new: &dyn Fn(VertexId) -> bool,
 ) -> Option<Vec<VertexId>> {
     let is_target = |v: VertexId| to.contains(&v);
-    let allowed = |v: VertexId| is_target(v) || !mesh.is_boundary_vertex(v);
+    let allowed = |v: VertexId| is_target(v) || !wall(mesh, blocked, v);
     let mut ends = to.to_vec();
     ends.push(from);
-    let near = near_boundary(mesh, &ends);
+    let near = near_boundary(mesh, blocked, &ends);
     let mut fan_cost = vec![1.0; mesh.n_vertices()];
     for &c in to {
         let fan: Vec<VertexId> = mesh.vertex_neighbors(c).collect();

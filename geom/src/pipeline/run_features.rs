@@ -1,5 +1,5 @@
-//! `run_features`: a `homology` job whose surfaces carry feature curves or boundary loops
-//! (genus 0): feature cut -> circle domains -> maps both ways -> anchor snapping -> smoothing
+//! `run_features`: a `homology` job whose surfaces carry feature curves (boundary loops on
+//! genus 0; on closed surfaces with handles through the canonical basis): feature cut -> circle domains -> maps both ways -> anchor snapping -> smoothing
 //! with every feature vertex held -> metrics (with the feature error) -> artifacts.
 
 use super::artifacts;
@@ -9,6 +9,7 @@ use super::run_homology::{
 };
 use super::spec::JobSpec;
 use crate::error::Result;
+use crate::homology::CanonicalBasisResult;
 use crate::homology::curve_align::CurveAlignOptions;
 use crate::homology::feature_cut::{FeatureCutResult, Side, SideKind};
 use crate::homology::feature_map::{FeatureMapOptions, FeatureSide, feature_error, feature_map};
@@ -27,8 +28,16 @@ pub struct FeatureReport {
     /// word and in `basis_*.json` follow it.
     pub order: Vec<(usize, bool)>,
     pub kinds: Vec<CurveKind>,
+    /// Genus of the surfaces.
+    pub genus: usize,
     /// Genus of the double cover the curves define (`2g + n − 1`).
     pub doubled_genus: usize,
+    /// Surfaces with handles: the induced map on H1 in the two canonical bases (column `j` is
+    /// the image of source loop `j`), and the polygon sides τ shifts by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub h1: Option<Vec<Vec<i32>>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub side_shift: Option<usize>,
     /// The cut disk's boundary word, e.g. `F1 L1 F2 F2^-1 L1^-1 F1^-1`.
     pub word: String,
     /// Largest distance of a mapped feature vertex from its partner curve, relative to the
@@ -63,29 +72,41 @@ pub(super) fn run_features(
     let fo = FeatureMapOptions {
         stretch_iterations: o.domain_stretch_iterations,
         align: o.align_curves.then(CurveAlignOptions::default),
+        basis: o.basis,
+        rotation: o.rotation,
+        max_subdivisions: None,
     };
     let r = feature_map(source, target, curves.0, curves.1, pairs, &fo)?;
     clock.lap("cut_domain_map");
     progress.check()?;
     // Open curves and the chain's junctions stay put; boundary vertices between junctions may
     // slide along the partner boundary (they stay on it).
-    let held = |c: &FeatureCutResult| -> Vec<VertexId> {
+    // (Cuts on a refinement hold only the mesh's own vertices.)
+    let held = |c: &FeatureCutResult, n: usize| -> Vec<VertexId> {
         let open = c.curves.iter().filter(|c| c.kind == CurveKind::Open).flat_map(|c| c.vertices.iter().copied());
         let ends = c.links.iter().flat_map(|l| [l[0], l[l.len() - 1]]);
         let starts = c.curves.iter().map(|c| c.vertices[0]);
-        open.chain(ends).chain(starts).collect()
+        open.chain(ends).chain(starts).filter(|v| v.idx() < n).collect()
     };
-    let (hs, ht) = (held(&r.source.cut), held(&r.target.cut));
+    let (hs, ht) = (held(&r.source.cut, source.n_vertices()), held(&r.target.cut, target.n_vertices()));
     let f = finish_pair(source, target, (&r.source_to_target, &r.target_to_source), pairs, (&hs, &ht), o, progress)?;
     clock.lap("smooth_metrics");
     progress.check()?;
-    let (sc, tc) = (&r.source.cut.curves, &r.target.cut.curves);
+    // The feature error on the meshes' own curves (the cut's may run through a refinement;
+    // on genus 0 they add the unlisted boundary loop).
+    let (sc, tc) = match &r.handles {
+        Some(_) => (curves.0, curves.1),
+        None => (&r.source.cut.curves[..], &r.target.cut.curves[..]),
+    };
     let mut report_f = FeatureReport {
-        curves: sc.len(),
+        curves: r.source.cut.curves.len(),
         order: r.order.clone(),
-        kinds: sc.iter().map(|c| c.kind).collect(),
+        kinds: r.source.cut.curves.iter().map(|c| c.kind).collect(),
+        genus: r.handles.as_ref().map_or(0, |h| h.source.genus()),
         doubled_genus: r.source.cut.doubled_genus,
-        word: word(&r.source.cut),
+        h1: r.handles.as_ref().map(|h| crate::homology::map::induced_h1_for(&h.source, &h.target, o.rotation)),
+        side_shift: r.handles.as_ref().map(|h| h.side_shift),
+        word: word(&r.source.cut, r.handles.as_ref().map(|h| &h.source)),
         feature_error: [feature_error(&f.s2t, target, sc, tc), feature_error(&f.t2s, source, tc, sc)],
         anchor_warp: r.warped,
         domain_flips: [r.source.domain.injectivity.flipped, r.target.domain.injectivity.flipped],
@@ -95,7 +116,9 @@ pub(super) fn run_features(
     let mut morph = None;
     if o.meta_mesh {
         progress.report("meta_mesh", 0.0);
-        let m = crate::homology::feature_overlay::feature_meta_mesh(&r.source, &r.target, source, target);
+        // On a refinement (same surface, more vertices) when the cut lives on one.
+        let (ms, mt) = (r.source.cut_mesh(source), r.target.cut_mesh(target));
+        let m = crate::homology::feature_overlay::feature_meta_mesh(&r.source, &r.target, ms, mt);
         let (stats, m) = meta_outputs(m, o, &mut arts);
         report_f.meta_mesh = Some(stats);
         morph = m;
@@ -103,8 +126,9 @@ pub(super) fn run_features(
     }
     // The morph: the meta-mesh pair when there is one, else the source to its image.
     arts.push(morph.unwrap_or_else(|| morph_glb(source, f.on_target.positions())));
-    arts.push(json_artifact("basis_source.json", &cut_json(&r.source, source))?);
-    arts.push(json_artifact("basis_target.json", &cut_json(&r.target, target))?);
+    let (bs, bt) = (r.handles.as_ref().map(|h| &h.source), r.handles.as_ref().map(|h| &h.target));
+    arts.push(json_artifact("basis_source.json", &cut_json(&r.source, source, bs))?);
+    arts.push(json_artifact("basis_target.json", &cut_json(&r.target, target, bt))?);
     arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });
     arts.push(Artifact { name: "domain_target.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.target)? });
     clock.lap("artifacts");
@@ -116,9 +140,10 @@ pub(super) fn run_features(
 }
 
 /// The boundary word: `F` for an open curve, `B` for a boundary arc, `L` for a link, `^-1`
-/// when a slit side comes back.
-fn word(c: &FeatureCutResult) -> String {
+/// when a slit side comes back; the polygon's sides as the basis reads them (`a1 b1 a1^-1 …`).
+fn word(c: &FeatureCutResult, basis: Option<&CanonicalBasisResult>) -> String {
     let mut seen = std::collections::HashSet::new();
+    let polygon: Vec<String> = basis.map(|b| b.word_text().split(' ').map(String::from).collect()).unwrap_or_default();
     c.sides
         .iter()
         .map(|s: &Side| {
@@ -126,6 +151,10 @@ fn word(c: &FeatureCutResult) -> String {
                 SideKind::Curve(i) if c.curves[i].kind == CurveKind::Boundary => ('B', i),
                 SideKind::Curve(i) => ('F', i),
                 SideKind::Link(i) => ('L', i),
+                SideKind::Basis(i) => match polygon.get(i) {
+                    Some(text) => return text.clone(),
+                    None => ('P', i),
+                },
             };
             let inv = if seen.insert(s.kind) || letter == 'B' { "" } else { "^-1" };
             format!("{letter}{}{inv}", i + 1)
@@ -135,8 +164,9 @@ fn word(c: &FeatureCutResult) -> String {
 }
 
 /// Curves and links as 3D polylines, the sides, and the double cover's genus.
-fn cut_json(fs: &FeatureSide, mesh: &Mesh) -> serde_json::Value {
+fn cut_json(fs: &FeatureSide, mesh: &Mesh, handles: Option<&CanonicalBasisResult>) -> serde_json::Value {
     let c = &fs.cut;
+    let mesh = fs.cut_mesh(mesh);
     let poly =
         |v: &[VertexId]| -> Vec<[f64; 3]> { v.iter().map(|&x| mesh.position(x)).map(|p| [p.x, p.y, p.z]).collect() };
     let curves: Vec<_> = c
@@ -147,15 +177,28 @@ fn cut_json(fs: &FeatureSide, mesh: &Mesh) -> serde_json::Value {
         .collect();
     let links: Vec<_> =
         c.links.iter().enumerate().map(|(i, l)| json!({"name": format!("L{}", i + 1), "points": poly(l)})).collect();
+    let basis = handles.map(|b| {
+        let loops: Vec<_> = b
+            .loops
+            .iter()
+            .enumerate()
+            .map(|(i, l)| {
+                let name = format!("{}{}", if i % 2 == 0 { 'a' } else { 'b' }, i / 2 + 1);
+                json!({"name": name, "points": poly(l)})
+            })
+            .collect();
+        json!({"loops": loops, "intersection": b.intersection, "word": b.word_text()})
+    });
     json!({
-        "genus": 0,
+        "genus": handles.map_or(0, |b| b.genus()),
+        "basis": basis,
         "doubled_genus": c.doubled_genus,
         "base_vertex": c.base.0,
         "curves": curves,
         "links": links,
         "sides": c.sides,
         "arc_start_angles": fs.domain.angles,
-        "word": word(c),
+        "word": word(c, handles),
         "disk_euler_characteristic": crate::topology::euler_characteristic(&c.disk.mesh),
     })
 }

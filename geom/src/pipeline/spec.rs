@@ -203,10 +203,10 @@ impl JobSpec {
             ))
             .into());
         }
-        if curves > 0 && ss.genus > 0 {
+        if ss.boundary_loops > 0 && ss.genus > 0 {
             return Err(InputError::TopologyMismatch(format!(
-                "feature curves and boundary loops are supported on genus-0 surfaces; these have genus {}",
-                ss.genus
+                "boundary loops are supported on genus-0 surfaces (features on closed surfaces of any genus); these have genus {} and {} boundary loops",
+                ss.genus, ss.boundary_loops
             ))
             .into());
         }

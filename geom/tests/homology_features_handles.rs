@@ -10,7 +10,7 @@ use geom::pipeline::{FeatureSpec, JobSpec, MapOptions, MapReport, Method, run_ma
 use geom::progress::NoProgress;
 
 mod common;
-use common::{bent, load, shuffled, twisted};
+use common::{bent, load, path_on_subdivided, shuffled, subdivided, twisted};
 
 /// `k` curves of about 5% of the diagonal, spread by farthest-point sampling, each a shortest
 /// edge path (along +x) from its centre, three rings apart from the others.
@@ -69,15 +69,25 @@ struct Run {
 
 /// A job on a same-shape pair (`gt[i]` is vertex `i`'s partner), curves carried over by `gt`.
 fn run(s: &Mesh, t: &Mesh, gt: &[u32], c: &[Vec<VertexId>], basis: [usize; 2], rotation: usize) -> Run {
+    let tc: Vec<Vec<VertexId>> = c.iter().map(|p| p.iter().map(|v| VertexId(gt[v.idx()])).collect()).collect();
+    run_with(s, t, gt, (c, &tc), basis, rotation)
+}
+
+/// [`run`] with the target's curves given.
+fn run_with(
+    s: &Mesh,
+    t: &Mesh,
+    gt: &[u32],
+    (c, tc): (&[Vec<VertexId>], &[Vec<VertexId>]),
+    basis: [usize; 2],
+    rotation: usize,
+) -> Run {
     let base = far_from(s, c);
-    let raw = |p: &[VertexId], map: &dyn Fn(u32) -> u32| p.iter().map(|v| map(v.0) as u64).collect::<Vec<_>>();
+    let raw = |p: &[VertexId]| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
     let sp = JobSpec {
         method: Method::Homology,
         anchors: vec![[base.0 as u64, gt[base.idx()] as u64]],
-        features: c
-            .iter()
-            .map(|p| FeatureSpec { source: raw(p, &|v| v), target: raw(p, &|v| gt[v as usize]) })
-            .collect(),
+        features: c.iter().zip(tc).map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) }).collect(),
         options: MapOptions { metric_samples: 5000, basis, rotation, ..Default::default() },
     };
     let (report, arts) = run_map(&sp, s, t, &mut NoProgress).unwrap();
@@ -137,6 +147,19 @@ fn kitten_with_four_features_on_a_twisted_copy_genus_one() {
     let f = r.report.features.as_ref().unwrap();
     assert_eq!((f.genus, f.doubled_genus, f.curves), (1, 5, 4));
     assert!(f.word.contains("L4 a1 b1 a1^-1 b1^-1 L4^-1"), "{}", f.word);
+}
+
+/// Another triangulation: the target is the source with every face split in four, its curves
+/// the source's through the midpoints.
+#[test]
+fn kitten_with_three_features_on_another_triangulation_genus_one() {
+    let s = load("kitten.nf20k.off");
+    let t = subdivided(&s);
+    let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let c = curves(&s, 3);
+    let tc: Vec<Vec<VertexId>> = c.iter().map(|p| path_on_subdivided(&s, &t, p)).collect();
+    let r = run_with(&s, &t, &gt, (&c, &tc), [0, 0], 0);
+    assert!(clean(&r), "gt {} {:?}", r.gt_mean, r.report.source_to_target);
 }
 
 #[test]

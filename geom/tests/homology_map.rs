@@ -7,7 +7,7 @@ use geom::pipeline::{JobSpec, MapOptions, MapReport, Method, run_map};
 use geom::progress::NoProgress;
 
 mod common;
-use common::{bent, load, shuffled};
+use common::{bent, load, shuffled, subdivided};
 
 struct Run {
     report: MapReport,
@@ -135,6 +135,25 @@ fn three_holes_bent_genus_three() {
     let h = r.report.homology.as_ref().unwrap();
     let others: Vec<_> = (1..3).map(|k| h1(&run(&s, &t, &gt, &[0], (h.rotation + k) % 3, h.basis))).collect();
     assert!(others.iter().all(|o| *o != h.h1) && others[0] != others[1]);
+}
+
+/// Another triangulation (every face split in four at its edge midpoints; vertex `i` ↔ vertex
+/// `i`): genus 1 maps cleanly in the first class; genus 2 in the first clean class of the
+/// enumeration (basis 1 on both meshes: the subdivided copy's shortest loops differ), whose other
+/// rotation is another class.
+#[test]
+fn another_triangulation_genus_one_and_two() {
+    let s = load("kitten.nf20k.off");
+    let t = subdivided(&s);
+    let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    assert_clean(&run(&s, &t, &gt, &[0], 0, [0, 0]), "kitten subdivided");
+    let s = load("eight_lowres.off");
+    let t = subdivided(&s);
+    let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let (r, _) = first_clean(&s, &t, &gt, 2);
+    assert_clean(&r, "eight_lowres subdivided");
+    let h = r.report.homology.as_ref().unwrap();
+    assert_ne!(h1(&run(&s, &t, &gt, &[0], h.rotation + 1, h.basis)), h.h1);
 }
 
 /// The meta-mesh pair (pruned below `prune` degrees if given): one face list, every vertex on

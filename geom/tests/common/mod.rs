@@ -51,6 +51,24 @@ pub fn shuffled(m: &Mesh) -> (Mesh, Vec<u32>) {
     (Mesh::from_triangles(pos, &faces).unwrap(), perm)
 }
 
+/// Another triangulation of the same surface: every face split into four at its edge
+/// midpoints. Vertex `i` of `m` is vertex `i` of the copy (the ground truth is the identity on
+/// them); the new vertices follow.
+pub fn subdivided(m: &Mesh) -> Mesh {
+    geom::homology::refine::Refined::identity(m).subdivide().unwrap().mesh
+}
+
+/// A vertex path of `m` on its subdivision `fine` ([`subdivided`]): each edge through its midpoint.
+pub fn path_on_subdivided(m: &Mesh, fine: &Mesh, path: &[geom::VertexId]) -> Vec<geom::VertexId> {
+    let mut out = vec![path[0]];
+    for w in path.windows(2) {
+        let mid = nalgebra::center(&m.position(w[0]), &m.position(w[1]));
+        let c = fine.vertex_neighbors(w[0]).find(|&c| fine.position(c) == mid).expect("the edge's midpoint");
+        out.extend([c, w[1]]);
+    }
+    out
+}
+
 fn gcd(a: u64, b: u64) -> u64 {
     if b == 0 { a } else { gcd(b, a % b) }
 }

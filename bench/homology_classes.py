@@ -13,7 +13,8 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 M = os.path.join(os.environ.get("SURFMAP_SHARED", os.path.join(HERE, "..", "..", "shared")), "meshes")
-PAIRS = [("kitten.nf20k.off", "rocker_arm/rocker-arm.obj", 4), ("eight.off", "cup_input_simple_10000.off", 2)]
+PAIRS = [p for p in [("kitten.nf20k.off", "rocker_arm/rocker-arm.obj", 4), ("eight.off", "cup_input_simple_10000.off", 2)]
+         if os.environ.get("PAIR", "") in p[0]]
 
 
 def main():

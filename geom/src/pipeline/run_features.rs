@@ -5,7 +5,7 @@
 use super::artifacts;
 use super::run::{Artifact, Clock, MapReport};
 use super::run_homology::{
-    finish_pair, finish_report, json_artifact, meta_outputs, morph_glb, pair_report, planar_obj,
+    finish_pair, finish_report, json_artifact, loops_json, meta_outputs, morph_glb, pair_report, planar_obj,
 };
 use super::spec::JobSpec;
 use crate::error::Result;
@@ -177,18 +177,7 @@ fn cut_json(fs: &FeatureSide, mesh: &Mesh, handles: Option<&CanonicalBasisResult
         .collect();
     let links: Vec<_> =
         c.links.iter().enumerate().map(|(i, l)| json!({"name": format!("L{}", i + 1), "points": poly(l)})).collect();
-    let basis = handles.map(|b| {
-        let loops: Vec<_> = b
-            .loops
-            .iter()
-            .enumerate()
-            .map(|(i, l)| {
-                let name = format!("{}{}", if i % 2 == 0 { 'a' } else { 'b' }, i / 2 + 1);
-                json!({"name": name, "points": poly(l)})
-            })
-            .collect();
-        json!({"loops": loops, "intersection": b.intersection, "word": b.word_text()})
-    });
+    let basis = handles.map(|b| json!({"loops": loops_json(b), "intersection": b.intersection, "word": b.word_text()}));
     json!({
         "genus": handles.map_or(0, |b| b.genus()),
         "basis": basis,

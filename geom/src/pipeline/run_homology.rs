@@ -285,13 +285,25 @@ pub(super) fn json_artifact(name: &str, v: &serde_json::Value) -> Result<Artifac
     Ok(Artifact { name: name.into(), content_type: "application/json", bytes })
 }
 
-/// Loops as 3D polylines (a1, b1, …), with vertex ids where they are original vertices, the
-/// intersection matrix and the boundary word.
+/// Loops as 3D polylines (a1, b1, …) on the basis's refinement, the intersection matrix and the
+/// boundary word.
 fn basis_json(sd: &SideDomain) -> serde_json::Value {
     let b = &sd.basis;
+    json!({
+        "genus": b.genus(),
+        "base_vertex": b.base.0,
+        "loops": loops_json(b),
+        "intersection": b.intersection,
+        "word": b.word_text(),
+        "subdivisions": b.subdivisions,
+        "disk_euler_characteristic": crate::topology::euler_characteristic(&b.disk.mesh),
+    })
+}
+
+/// A basis's loops as named 3D polylines (`a1`, `b1`, …), on its refinement.
+pub(super) fn loops_json(b: &crate::homology::CanonicalBasisResult) -> Vec<serde_json::Value> {
     let m = &b.refined.mesh;
-    let loops: Vec<_> = b
-        .loops
+    b.loops
         .iter()
         .enumerate()
         .map(|(i, l)| {
@@ -299,16 +311,7 @@ fn basis_json(sd: &SideDomain) -> serde_json::Value {
             let pts: Vec<[f64; 3]> = l.iter().map(|&v| m.position(v)).map(|p| [p.x, p.y, p.z]).collect();
             json!({"name": name, "points": pts})
         })
-        .collect();
-    json!({
-        "genus": b.genus(),
-        "base_vertex": b.base.0,
-        "loops": loops,
-        "intersection": b.intersection,
-        "word": b.word_text(),
-        "subdivisions": b.subdivisions,
-        "disk_euler_characteristic": crate::topology::euler_characteristic(&b.disk.mesh),
-    })
+        .collect()
 }
 
 /// The planar 4g-gon as a mesh at z = 0.

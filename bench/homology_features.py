@@ -163,7 +163,11 @@ def main():
             ("bunny twisted (closed)", "bunny.off", "twist"), ("face shuffled", "face.off", "shuffle"),
             ("kitten twisted (genus 1)", "kitten.nf20k.off", "twist"), ("torus shuffled (genus 1)", "torus.obj", "shuffle"),
             ("eight bent (genus 2)", "eight.off", "bend"), ("genus3 twisted (genus 3)", "genus3.off", "twist"),
-            ("3holes shuffled (genus 3)", "3holes.off", "shuffle")]
+            ("3holes shuffled (genus 3)", "3holes.off", "shuffle"),
+            ("eight_lowres shuffled (genus 2)", "eight_lowres.off", "shuffle"),
+            ("rocker arm bent (genus 1)", "rocker_arm/rocker-arm.obj", "bend"),
+            ("skull twisted (genus 2)", "skull_low_resolution.obj", "twist"),
+            ("fertility bent (genus 4)", "fertility.off", "bend")]
     diff = [("face ↔ hand", "face.off", "hand_lowres.obj"), ("face ↔ demosthenes", "face.off", "demosthenes-low-res.obj"),
             ("demosthenes ↔ camelhead", "demosthenes-low-res.obj", "camelhead.off"),
             ("cow ↔ horse (closed)", "cow.off", "horse.off"),

@@ -142,7 +142,25 @@ pub fn canonical_basis_avoiding(
             let attempt = round * ATTEMPTS_PER_ROUND + extra;
             let t0 = std::time::Instant::now();
             let blocked = blocked_by(&local.mesh, &local_curves);
-            let res = search(&local.mesh, &blocked, base, g, opts.basis_index)?;
+            let mut res = search(&local.mesh, &blocked, base, g, opts.basis_index)?;
+            // With walls, the first handle's class can leave a later handle no room where the
+            // next classes do: try those before refining (the stuck search's loops still
+            // decide the refinement). Without walls nothing changes.
+            if let Err(stuck) = &res
+                && !blocked.is_empty()
+                && attempt >= opts.min_attempt
+            {
+                let stuck = stuck.clone();
+                for k in 1..=WALLED_EXTRA_CLASSES {
+                    if let Ok(loops) = search(&local.mesh, &blocked, base, g, opts.basis_index + k)? {
+                        res = Ok(loops);
+                        break;
+                    }
+                }
+                if res.is_err() {
+                    res = Err(stuck);
+                }
+            }
             debug(|| {
                 format!(
                     "attempt round {round} extra {extra}: {} vertices, {:.2} s, {}",
@@ -183,8 +201,13 @@ pub fn canonical_basis_avoiding(
             refine_with(&mut refined, &mut curves, |r| r.subdivide()?.raise_valence(base, 8 * g + 8))?;
         }
     }
+    let walls = if avoid.is_empty() {
+        ""
+    } else {
+        " that keeps off the feature curves (try another base vertex, i.e. first anchor, another basis index, or curves placed apart from the handles)"
+    };
     Err(InputError::Invalid(format!(
-        "canonical basis: no {}-loop basis through vertex {} with disjoint loops after {} subdivisions",
+        "canonical basis: no {}-loop basis through vertex {} with disjoint loops{walls} after {} subdivisions",
         2 * g,
         base.0,
         opts.max_subdivisions
@@ -222,6 +245,9 @@ fn blocked_by(mesh: &Mesh, curves: &[Vec<VertexId>]) -> Vec<bool> {
 fn blocked_on(s: &CutMesh, blocked: &[bool]) -> Vec<bool> {
     if blocked.is_empty() { Vec::new() } else { s.orig.iter().map(|o| blocked[o.idx()]).collect() }
 }
+
+/// Further classes of the first loop tried before refining, when curves are walls.
+const WALLED_EXTRA_CLASSES: usize = 2;
 
 /// Searches per subdivision round (each failed one refines before the next).
 pub(crate) const ATTEMPTS_PER_ROUND: usize = 6;
@@ -264,7 +290,10 @@ fn search(
     for handle in 0..g {
         let mut done = None;
         'corners: for &corner in &corners {
-            let (skip, count) = if handle == 0 { (first, first + 1) } else { (0, 3) };
+            // With walls (feature curves) the first handle may also try the next two classes:
+            // a loop that runs beside a curve can leave its crossing path no room.
+            let extra = if blocked.is_empty() { 0 } else { 2 };
+            let (skip, count) = if handle == 0 { (first, first + 1 + extra) } else { (0, 3) };
             // Candidates one at a time: the first that admits its crossing loop ends the search.
             let mut seen = 0;
             let n_cands = each_nonseparating_loop(&s.mesh, &walls, corner, count, &mut |a| {

@@ -200,6 +200,13 @@ pub fn handle_cuts(
         let min_attempt = round * super::basis::ATTEMPTS_PER_ROUND;
         match cuts_at(meshes, curves, bases, o, min_attempt) {
             Err(e) if round < rounds && matches!(e, Error::Input(InputError::Features(_))) => round += 1,
+            // The chain's vertex ids are the cut disk's: say where the search ran instead.
+            Err(Error::Input(InputError::Features(m))) => {
+                return Err(InputError::Features(format!(
+                    "{m} (in the disk the canonical basis cuts, after {round} subdivisions; another base vertex, i.e. first anchor, or basis index may leave room)"
+                ))
+                .into());
+            }
             r => return r,
         }
     }

@@ -12,55 +12,10 @@ use geom::progress::NoProgress;
 mod common;
 use common::{bent, load, twisted};
 
-/// `k` feature curves: centres spread by farthest-point sampling over vertices two rings away
-/// from the boundary and from earlier curves, each a shortest path of about 6% of the diagonal
-/// towards +x.
+/// `k` feature curves of about 6% of the diagonal, two rings from the boundary and each other
+/// ([`common::feature_curves`]).
 fn features(m: &Mesh, k: usize) -> Vec<Vec<VertexId>> {
-    let n = m.n_vertices();
-    let mut blocked: Vec<bool> = (0..n).map(|v| m.is_boundary_vertex(VertexId::from_idx(v))).collect();
-    let grow = |b: &mut Vec<bool>, times: usize| {
-        for _ in 0..times {
-            let cur = b.clone();
-            for (v, _) in cur.iter().enumerate().filter(|x| *x.1) {
-                for w in m.vertex_neighbors(VertexId::from_idx(v)) {
-                    b[w.idx()] = true;
-                }
-            }
-        }
-    };
-    grow(&mut blocked, 2);
-    let r = 0.06 * m.bbox_diagonal();
-    let mut centres: Vec<VertexId> = Vec::new();
-    let mut out = Vec::new();
-    for _ in 0..k {
-        let free = (0..n).map(VertexId::from_idx).filter(|v| !blocked[v.idx()]);
-        let c = free
-            .max_by(|&a, &b| {
-                let d =
-                    |v: VertexId| centres.iter().map(|&c| (m.position(v) - m.position(c)).norm()).fold(1e300, f64::min);
-                d(a).total_cmp(&d(b))
-            })
-            .expect("room for a curve");
-        let o = VertexDijkstraOptions { blocked: Some(&blocked), max_distance: Some(r), ..Default::default() };
-        let d = vertex_dijkstra(m, &[(c, 0.0)], &o).unwrap();
-        let end = (0..n)
-            .map(VertexId::from_idx)
-            .filter(|v| d.dist[v.idx()] > 0.6 * r && d.dist[v.idx()] <= r)
-            .max_by(|a, b| m.position(*a).x.total_cmp(&m.position(*b).x))
-            .expect("an end");
-        let p = d.path_to(end).unwrap();
-        let mut ring = vec![false; n];
-        for v in &p {
-            ring[v.idx()] = true;
-        }
-        grow(&mut ring, 2);
-        for (b, r) in blocked.iter_mut().zip(&ring) {
-            *b |= r;
-        }
-        centres.push(c);
-        out.push(p);
-    }
-    out
+    common::feature_curves(m, k, 0.06, 2)
 }
 
 fn spec(curves: &[Vec<VertexId>], anchors: Vec<[u64; 2]>) -> JobSpec {

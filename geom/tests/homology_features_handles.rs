@@ -12,46 +12,9 @@ use geom::progress::NoProgress;
 mod common;
 use common::{bent, load, path_on_subdivided, shuffled, subdivided, twisted};
 
-/// `k` curves of about 5% of the diagonal, spread by farthest-point sampling, each a shortest
-/// edge path (along +x) from its centre, three rings apart from the others.
+/// `k` curves of about 5% of the diagonal, three rings apart.
 fn curves(m: &Mesh, k: usize) -> Vec<Vec<VertexId>> {
-    use geom::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
-    let n = m.n_vertices();
-    let mut blocked = vec![false; n];
-    let r = 0.05 * m.bbox_diagonal();
-    let mut centres: Vec<VertexId> = Vec::new();
-    let mut out = Vec::new();
-    for _ in 0..k {
-        let d = |v: VertexId| centres.iter().map(|&c| (m.position(v) - m.position(c)).norm()).fold(1e300, f64::min);
-        let c = (0..n).map(VertexId::from_idx).filter(|v| !blocked[v.idx()]).max_by(|&a, &b| d(a).total_cmp(&d(b)));
-        let c = c.expect("room for a curve");
-        let o = VertexDijkstraOptions { blocked: Some(&blocked), max_distance: Some(r), ..Default::default() };
-        let dist = vertex_dijkstra(m, &[(c, 0.0)], &o).unwrap();
-        let end = (0..n)
-            .map(VertexId::from_idx)
-            .filter(|v| dist.dist[v.idx()] > 0.6 * r && dist.dist[v.idx()] <= r)
-            .max_by(|a, b| m.position(*a).x.total_cmp(&m.position(*b).x))
-            .expect("an end");
-        let p = dist.path_to(end).unwrap();
-        let mut ring: Vec<bool> = vec![false; n];
-        for v in &p {
-            ring[v.idx()] = true;
-        }
-        for _ in 0..3 {
-            let cur = ring.clone();
-            for v in (0..n).filter(|&v| cur[v]) {
-                for w in m.vertex_neighbors(VertexId::from_idx(v)) {
-                    ring[w.idx()] = true;
-                }
-            }
-        }
-        for (b, x) in blocked.iter_mut().zip(&ring) {
-            *b |= x;
-        }
-        centres.push(c);
-        out.push(p);
-    }
-    out
+    common::feature_curves(m, k, 0.05, 3)
 }
 
 /// The vertex farthest from every curve: the base anchor.
@@ -69,8 +32,24 @@ struct Run {
 
 /// A job on a same-shape pair (`gt[i]` is vertex `i`'s partner), curves carried over by `gt`.
 fn run(s: &Mesh, t: &Mesh, gt: &[u32], c: &[Vec<VertexId>], basis: [usize; 2], rotation: usize) -> Run {
-    let tc: Vec<Vec<VertexId>> = c.iter().map(|p| p.iter().map(|v| VertexId(gt[v.idx()])).collect()).collect();
-    run_with(s, t, gt, (c, &tc), basis, rotation)
+    run_with(s, t, gt, (c, &carried(c, gt)), basis, rotation)
+}
+
+/// The curves' vertices mapped by `gt`.
+fn carried(c: &[Vec<VertexId>], gt: &[u32]) -> Vec<Vec<VertexId>> {
+    c.iter().map(|p| p.iter().map(|v| VertexId(gt[v.idx()])).collect()).collect()
+}
+
+/// The job: base anchor farthest from the curves (and its partner), the curve pairs, `options`.
+fn job(s: &Mesh, gt: &[u32], (c, tc): (&[Vec<VertexId>], &[Vec<VertexId>]), options: MapOptions) -> JobSpec {
+    let base = far_from(s, c);
+    let raw = |p: &[VertexId]| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
+    JobSpec {
+        method: Method::Homology,
+        anchors: vec![[base.0 as u64, gt[base.idx()] as u64]],
+        features: c.iter().zip(tc).map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) }).collect(),
+        options,
+    }
 }
 
 /// [`run`] with the target's curves given.
@@ -82,14 +61,7 @@ fn run_with(
     basis: [usize; 2],
     rotation: usize,
 ) -> Run {
-    let base = far_from(s, c);
-    let raw = |p: &[VertexId]| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
-    let sp = JobSpec {
-        method: Method::Homology,
-        anchors: vec![[base.0 as u64, gt[base.idx()] as u64]],
-        features: c.iter().zip(tc).map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) }).collect(),
-        options: MapOptions { metric_samples: 5000, basis, rotation, ..Default::default() },
-    };
+    let sp = job(s, gt, (c, tc), MapOptions { metric_samples: 5000, basis, rotation, ..Default::default() });
     let (report, arts) = run_map(&sp, s, t, &mut NoProgress).unwrap();
     common::assert_artifacts(
         &arts,
@@ -198,17 +170,8 @@ fn three_holes_with_four_features_on_a_shuffled_copy_genus_three_with_meta_mesh(
     assert!(clean(&r) && r.gt_mean < 1e-9, "gt {}", r.gt_mean);
     assert_eq!(r.report.features.as_ref().unwrap().doubled_genus, 9);
     // The meta-mesh of the pair: one face list, χ of genus 3, every vertex on its surface.
-    let base = far_from(&s, &c);
-    let raw = |p: &[VertexId], map: &dyn Fn(u32) -> u32| p.iter().map(|v| map(v.0) as u64).collect::<Vec<_>>();
-    let sp = JobSpec {
-        method: Method::Homology,
-        anchors: vec![[base.0 as u64, gt[base.idx()] as u64]],
-        features: c
-            .iter()
-            .map(|p| FeatureSpec { source: raw(p, &|v| v), target: raw(p, &|v| gt[v as usize]) })
-            .collect(),
-        options: MapOptions { metric_samples: 2000, meta_mesh: true, ..Default::default() },
-    };
+    let options = MapOptions { metric_samples: 2000, meta_mesh: true, ..Default::default() };
+    let sp = job(&s, &gt, (&c, &carried(&c, &gt)), options);
     let (rep, arts) = run_map(&sp, &s, &t, &mut NoProgress).unwrap();
     let stats = rep.features.unwrap().meta_mesh.expect("meta-mesh statistics");
     assert!(stats.error.is_none(), "{stats:?}");

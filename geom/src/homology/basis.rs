@@ -146,19 +146,12 @@ pub fn canonical_basis_avoiding(
             // With walls, the first handle's class can leave a later handle no room where the
             // next classes do: try those before refining (the stuck search's loops still
             // decide the refinement). Without walls nothing changes.
-            if let Err(stuck) = &res
-                && !blocked.is_empty()
-                && attempt >= opts.min_attempt
-            {
-                let stuck = stuck.clone();
+            if res.is_err() && !blocked.is_empty() && attempt >= opts.min_attempt {
                 for k in 1..=WALLED_EXTRA_CLASSES {
                     if let Ok(loops) = search(&local.mesh, &blocked, base, g, opts.basis_index + k)? {
                         res = Ok(loops);
                         break;
                     }
-                }
-                if res.is_err() {
-                    res = Err(stuck);
                 }
             }
             debug(|| {
@@ -246,7 +239,8 @@ fn blocked_on(s: &CutMesh, blocked: &[bool]) -> Vec<bool> {
     if blocked.is_empty() { Vec::new() } else { s.orig.iter().map(|o| blocked[o.idx()]).collect() }
 }
 
-/// Further classes of the first loop tried before refining, when curves are walls.
+/// Further classes of the first loop tried, when curves are walls: by the first handle, and by
+/// a whole search before refining.
 const WALLED_EXTRA_CLASSES: usize = 2;
 
 /// Searches per subdivision round (each failed one refines before the next).
@@ -292,7 +286,7 @@ fn search(
         'corners: for &corner in &corners {
             // With walls (feature curves) the first handle may also try the next two classes:
             // a loop that runs beside a curve can leave its crossing path no room.
-            let extra = if blocked.is_empty() { 0 } else { 2 };
+            let extra = if blocked.is_empty() { 0 } else { WALLED_EXTRA_CLASSES };
             let (skip, count) = if handle == 0 { (first, first + 1 + extra) } else { (0, 3) };
             // Candidates one at a time: the first that admits its crossing loop ends the search.
             let mut seen = 0;
@@ -329,13 +323,12 @@ fn search(
         if corners.is_empty() {
             return Err(Error::Internal(format!("basis: handle {} left a non-canonical word", handle + 1)));
         }
+        walls = blocked_on(&s2, blocked);
         {
-            let w2 = blocked_on(&s2, blocked);
-            let reach = interior_components(&s2.mesh, &w2);
+            let reach = interior_components(&s2.mesh, &walls);
             corners
                 .sort_by_key(|&c| std::cmp::Reverse((reach(c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0))));
         }
-        walls = blocked_on(&s2, blocked);
         s = s2;
     }
     Ok(Ok(loops))

@@ -80,6 +80,13 @@ pub fn feature_cut(
     anchor: Option<VertexId>,
     loop_start: Option<VertexId>,
 ) -> Result<FeatureCutResult> {
+    let genus = topology::summary(mesh).genus;
+    if genus != 0 {
+        return Err(InputError::TopologyMismatch(format!(
+            "the feature cut opens genus-0 surfaces (a surface with handles is cut through its canonical basis first); this one has genus {genus}"
+        ))
+        .into());
+    }
     match cut_with(mesh, curves, order, anchor, loop_start, false) {
         Err(Error::Input(InputError::Features(_))) => cut_with(mesh, curves, order, anchor, loop_start, true),
         r => r,
@@ -96,14 +103,6 @@ fn cut_with(
     loop_start: Option<VertexId>,
     clear: bool,
 ) -> Result<FeatureCutResult> {
-    let s = topology::summary(mesh);
-    if s.genus != 0 {
-        return Err(InputError::TopologyMismatch(format!(
-            "feature curves are supported on genus-0 surfaces (with or without boundary); this one has genus {}",
-            s.genus
-        ))
-        .into());
-    }
     if order.len() != curves.len() {
         return Err(Error::Internal(format!("chain order of {} for {} curves", order.len(), curves.len())));
     }

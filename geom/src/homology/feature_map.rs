@@ -99,13 +99,9 @@ pub fn feature_map(
             .into());
         }
     }
-    let genus = crate::topology::summary(source).genus;
-    if genus != crate::topology::summary(target).genus {
-        return Err(InputError::TopologyMismatch(format!(
-            "source genus {genus}, target genus {}",
-            crate::topology::summary(target).genus
-        ))
-        .into());
+    let (genus, target_genus) = (crate::topology::summary(source).genus, crate::topology::summary(target).genus);
+    if genus != target_genus {
+        return Err(InputError::TopologyMismatch(format!("source genus {genus}, target genus {target_genus}")).into());
     }
     if genus > 0 {
         let &(bs, bt) = anchors.first().ok_or_else(|| {

@@ -1,6 +1,7 @@
 //! `run_features`: a `homology` job whose surfaces carry feature curves (boundary loops on
-//! genus 0; on closed surfaces with handles through the canonical basis): feature cut -> circle domains -> maps both ways -> anchor snapping -> smoothing
-//! with every feature vertex held -> metrics (with the feature error) -> artifacts.
+//! genus 0; on closed surfaces with handles through the canonical basis): feature cut -> circle
+//! domains -> maps both ways -> anchor snapping -> smoothing with every feature vertex held ->
+//! metrics (with the feature error) -> artifacts.
 
 use super::artifacts;
 use super::run::{Artifact, Clock, MapReport};

@@ -69,6 +69,54 @@ pub fn path_on_subdivided(m: &Mesh, fine: &Mesh, path: &[geom::VertexId]) -> Vec
     out
 }
 
+/// `k` feature curves: centres spread by farthest-point sampling over vertices `gap` rings away
+/// from the boundary and from earlier curves, each a shortest edge path of about `length` times
+/// the diagonal from its centre, ending towards +x.
+pub fn feature_curves(m: &Mesh, k: usize, length: f64, gap: usize) -> Vec<Vec<geom::VertexId>> {
+    use geom::VertexId;
+    use geom::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
+    let n = m.n_vertices();
+    let grow = |b: &mut Vec<bool>| {
+        for _ in 0..gap {
+            let cur = b.clone();
+            for v in (0..n).filter(|&v| cur[v]) {
+                for w in m.vertex_neighbors(VertexId::from_idx(v)) {
+                    b[w.idx()] = true;
+                }
+            }
+        }
+    };
+    let mut blocked: Vec<bool> = (0..n).map(|v| m.is_boundary_vertex(VertexId::from_idx(v))).collect();
+    grow(&mut blocked);
+    let r = length * m.bbox_diagonal();
+    let mut centres: Vec<VertexId> = Vec::new();
+    let mut out = Vec::new();
+    for _ in 0..k {
+        let d = |v: VertexId| centres.iter().map(|&c| (m.position(v) - m.position(c)).norm()).fold(1e300, f64::min);
+        let c = (0..n).map(VertexId::from_idx).filter(|v| !blocked[v.idx()]).max_by(|&a, &b| d(a).total_cmp(&d(b)));
+        let c = c.expect("room for a curve");
+        let o = VertexDijkstraOptions { blocked: Some(&blocked), max_distance: Some(r), ..Default::default() };
+        let dist = vertex_dijkstra(m, &[(c, 0.0)], &o).unwrap();
+        let end = (0..n)
+            .map(VertexId::from_idx)
+            .filter(|v| dist.dist[v.idx()] > 0.6 * r && dist.dist[v.idx()] <= r)
+            .max_by(|a, b| m.position(*a).x.total_cmp(&m.position(*b).x))
+            .expect("an end");
+        let p = dist.path_to(end).unwrap();
+        let mut ring = vec![false; n];
+        for v in &p {
+            ring[v.idx()] = true;
+        }
+        grow(&mut ring);
+        for (b, x) in blocked.iter_mut().zip(&ring) {
+            *b |= x;
+        }
+        centres.push(c);
+        out.push(p);
+    }
+    out
+}
+
 fn gcd(a: u64, b: u64) -> u64 {
     if b == 0 { a } else { gcd(b, a % b) }
 }

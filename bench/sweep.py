@@ -70,9 +70,13 @@ def main():
                 continue
             gtm = e.get("gt_error_mean", float("nan"))
             fb = e["report"].get("layout", {}).get("fallback")
+            g = e["report"].get("global")
+            if g and not g["used"]:
+                fb = f"{fb or ''} per-patch: {g.get('fallback')}"
             name = f"{name} [{fb}]" if fb else name
             line = (f"{name:32s} {e['time']:6.2f}s flips {e['flipped_faces']}/{e['rev_flips']} area {e['area_ratio']:.4f} "
-                    f"L2 {e['l2_stretch']:.4f} gt {gtm:.4f} anchor {e['anchor_error_max']:.1e} off {e['off_surface_max']:.1e}")
+                    f"L2 {e['l2_stretch']:.4f} gt {gtm:.4f} anchor {e['anchor_error_max']:.1e} off {e['off_surface_max']:.1e}"
+                    + (f" E0 {e['report']['smoothing']['energy_before']:.3f} G {e['report'].get('global')}" if os.environ.get("SWEEP_ENERGY") else ""))
             miss = e["flipped_faces"] or e["rev_flips"] or not 0.97 <= e["area_ratio"] <= 1.03 or \
                 e["anchor_error_max"] > 1e-9 or e["off_surface_max"] > 1e-6
             if miss:

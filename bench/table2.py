@@ -168,7 +168,11 @@ def cases(tmp, binary):
 
 def run(binary, tmp, name, s, t, anchors, gt, method, spec=None, repeats=3):
     """Runs `surfmap map` `repeats` times (wall median) and judges the result with the evaluator.
-    `spec`: a whole job spec (written to a file and passed with --spec) instead of --method."""
+    `spec`: a whole job spec (written to a file and passed with --spec) instead of --method.
+    `SURFMAP_OPTIONS` (JSON) in the environment: job options for every run without a spec."""
+    extra = os.environ.get("SURFMAP_OPTIONS")
+    if spec is None and extra:
+        spec = {"method": method, "anchors": anchors, "options": json.loads(extra)}
     if spec is None:
         af = os.path.join(tmp, "anchors.json")
         json.dump({"anchors": anchors}, open(af, "w"))

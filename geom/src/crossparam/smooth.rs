@@ -117,6 +117,40 @@ impl SourceFrame {
     }
 }
 
+/// What [`map_quality`] measures of a map before smoothing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MapQuality {
+    /// Symmetric Dirichlet energy (summed over source faces, source areas as weights, the
+    /// target scaled to the source's area), as [`smooth`] measures it before it moves anything;
+    /// a face mapped flat counts as `f64::MAX` divided by the face count.
+    pub energy: f64,
+    /// Faces whose mapped normal opposes the target's at all three corners.
+    pub flipped: usize,
+    /// Mapped area over the target's area.
+    pub area_ratio: f64,
+}
+
+/// Measures `map` from `source` onto `target`: the figures by which two candidate maps are
+/// compared before one is smoothed.
+pub fn map_quality(source: &Mesh, target: &Mesh, map: &SurfaceMap) -> MapQuality {
+    let scale = (source.area() / target.area().max(f64::MIN_POSITIVE)).sqrt();
+    let pos: Vec<P3> = (0..source.n_vertices()).map(|v| map.position(VertexId::from_idx(v), target)).collect();
+    let flat = f64::MAX / source.n_faces().max(1) as f64;
+    let mut q = MapQuality { energy: 0.0, flipped: 0, area_ratio: 0.0 };
+    for f in 0..source.n_faces() {
+        let tri = source.face(FaceId::from_idx(f));
+        let m = tri.map(|w| pos[w.idx()]);
+        if let Some(fr) = SourceFrame::new(tri.map(|w| source.position(w))) {
+            q.energy += fr.energy(m, scale).unwrap_or(flat);
+        }
+        let n = (m[1] - m[0]).cross(&(m[2] - m[0]));
+        q.area_ratio += 0.5 * n.norm();
+        q.flipped += usize::from(tri.iter().all(|w| n.dot(&target.face_normal_raw(map.face[w.idx()])) < 0.0));
+    }
+    q.area_ratio /= target.area().max(f64::MIN_POSITIVE);
+    q
+}
+
 /// Faces of `v`'s star in `source` that face against `target` at all their corners (the
 /// evaluator's flip rule, with the target faces the corners lie on), were `v`'s image at `p`
 /// on face `f` and every other vertex `w` at `pos[w]` on face `faces[w]`.

@@ -4,8 +4,9 @@
 use super::artifacts;
 use super::spec::{JobSpec, Method};
 use crate::crossparam::{compose, parameterize_patches, smooth};
+use crate::domain::refine::{Refined, refine};
 use crate::domain::tracer::Tracer;
-use crate::domain::{LayoutStats, greedy, patches_of, refine::refine, voronoi};
+use crate::domain::{LayoutStats, greedy, patches_of, voronoi};
 use crate::error::{Error, InputError, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
@@ -43,6 +44,28 @@ pub struct MapReport {
     /// `homology` jobs with feature curves or boundaries: the cut and how exactly features map.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub features: Option<super::run_features::FeatureReport>,
+    /// `voronoi` / `greedy`: the global map onto the base domain, when it was tried.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub global: Option<GlobalReport>,
+}
+
+/// What the global map onto the base domain did ([`crate::crossparam::global`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct GlobalReport {
+    /// Whether its maps were used (`false`: the per-patch maps were, see `fallback`).
+    pub used: bool,
+    /// Why the per-patch maps were used instead.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<String>,
+    /// Source and target: triangles folded in the domain and the L2 stretch of their maps.
+    pub flipped: [usize; 2],
+    pub l2_stretch: [f64; 2],
+    /// Per-patch and global composition before smoothing, both directions summed: distortion
+    /// energy (symmetric Dirichlet), folded faces, and |area ratio - 1|. The global one is used
+    /// when it is better on all three.
+    pub energy: [f64; 2],
+    pub folded: [usize; 2],
+    pub area_deviation: [f64; 2],
 }
 
 pub(super) struct Clock(pub(super) Instant, pub(super) Vec<(String, f64)>);
@@ -212,11 +235,15 @@ pub fn run_map(
     )?;
     let (ps, pt) = (ps?, pt?);
     clock.lap("parameterize");
-    progress.report("compose", 0.0);
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
+    progress.report("compose", 0.0);
     let (s2t, t2s) =
         both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
     clock.lap("compose");
+    let inputs = GlobalInputs { patches: &patches, refined: (&rs, &rt), anchors: (&sa, &ta), params: (&ps, &pt) };
+    let ((s2t, t2s), global_report) =
+        choose_global(source, target, &inputs, (s2t, t2s), &pairs, &rev, &o.global, progress)?;
+    clock.lap("global");
     progress.check()?;
     // The two directions are independent from here on: each thread smooths its map, makes it
     // visible to the evaluator's rules, embeds it and measures it, so the lighter direction's
@@ -250,6 +277,7 @@ pub fn run_map(
         smoothing: r1.merge(r2),
         homology: None,
         features: None,
+        global: global_report,
     };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, &result, &on_target, &on_source)?;
     clock.lap("artifacts");
@@ -260,4 +288,109 @@ pub fn run_map(
     arts.push(Artifact { name: "metrics.json".into(), content_type: "application/json", bytes: json });
     progress.report("done", 1.0);
     Ok((report, arts))
+}
+
+/// What [`choose_global`] needs of the layout: patches, both refinements, both anchor lists
+/// and both per-patch parameterizations (source, target).
+struct GlobalInputs<'a> {
+    patches: &'a [crate::domain::Patch],
+    refined: (&'a Refined, &'a Refined),
+    anchors: (&'a [VertexId], &'a [VertexId]),
+    params: (&'a [crate::crossparam::PatchParam], &'a [crate::crossparam::PatchParam]),
+}
+
+/// Before smoothing, a map pair's distortion energy (symmetric Dirichlet), folded faces and
+/// |area ratio − 1|, both directions summed.
+fn pair_quality(source: &Mesh, target: &Mesh, s2t: &SurfaceMap, t2s: &SurfaceMap) -> Result<(f64, usize, f64)> {
+    let (x, y) = both(|| smooth::map_quality(target, source, t2s), || smooth::map_quality(source, target, s2t))?;
+    Ok((x.energy + y.energy, x.flipped + y.flipped, (x.area_ratio - 1.0).abs() + (y.area_ratio - 1.0).abs()))
+}
+
+/// The per-patch composition `maps`, or the composition of both meshes' global maps onto the
+/// base domain ([`crate::crossparam::global`]) when that is better on every count before
+/// smoothing: lower distortion energy, no more folded faces, an area ratio closer to 1. Its
+/// domain maps may fold near cone points, and energy alone prefers a fold-free squeeze to a
+/// clean map (cat poses), hence all three. The global maps are only computed when the
+/// per-patch composition has a folded face or an area ratio off by more than
+/// `min_area_deviation` (a clean composition costs nothing more), on closed meshes, and when
+/// enabled; a failure of theirs keeps the per-patch maps.
+#[allow(clippy::too_many_arguments)]
+fn choose_global(
+    source: &Mesh,
+    target: &Mesh,
+    inputs: &GlobalInputs,
+    maps: (SurfaceMap, SurfaceMap),
+    pairs: &[(VertexId, VertexId)],
+    rev: &[(VertexId, VertexId)],
+    opts: &crate::crossparam::global::GlobalParamOptions,
+    progress: &mut dyn Progress,
+) -> Result<((SurfaceMap, SurfaceMap), Option<GlobalReport>)> {
+    use crate::crossparam::global::{DomainMetric, compose as gcompose, global_param};
+    if !opts.enabled || topology::boundary_loops(source).len() + topology::boundary_loops(target).len() > 0 {
+        return Ok((maps, None));
+    }
+    let p = pair_quality(source, target, &maps.0, &maps.1)?;
+    let mut report = GlobalReport {
+        used: false,
+        fallback: None,
+        flipped: [0; 2],
+        l2_stretch: [f64::NAN; 2],
+        energy: [p.0, f64::NAN],
+        folded: [p.1, 0],
+        area_deviation: [p.2, f64::NAN],
+    };
+    if !opts.force && p.1 == 0 && p.2 <= opts.min_area_deviation {
+        report.fallback = Some("the per-patch composition is clean".into());
+        return Ok((maps, Some(report)));
+    }
+    progress.report("global", 0.0);
+    let (rs, rt) = inputs.refined;
+    let (sa, ta) = inputs.anchors;
+    let patches = inputs.patches;
+    let is = crate::crossparam::compose::vertex_uv(inputs.params.0, source.n_vertices());
+    let it = crate::crossparam::compose::vertex_uv(inputs.params.1, target.n_vertices());
+    // The base domain's side lengths: each path's length on both meshes, each scaled by
+    // √area, averaged.
+    let path_len = |r: &Refined, m: &Mesh| -> Vec<f64> {
+        let s = m.area().sqrt().max(f64::MIN_POSITIVE);
+        r.path_vertices
+            .iter()
+            .map(|p| p.windows(2).map(|w| (r.mesh.position(w[1]) - r.mesh.position(w[0])).norm()).sum::<f64>() / s)
+            .collect()
+    };
+    let lengths: Vec<f64> = path_len(rs, source).iter().zip(path_len(rt, target)).map(|(a, b)| 0.5 * (a + b)).collect();
+    let lengths = (opts.metric == DomainMetric::PathLengths).then_some(&lengths[..]);
+    let (gs, gt) = both(
+        || global_param(target, patches, ta, &it, Some(rt), lengths, opts, &mut crate::progress::NoProgress),
+        || global_param(source, patches, sa, &is, Some(rs), lengths, opts, progress),
+    )?;
+    let (gs, gt) = match (gs, gt) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e @ Error::Cancelled), _) | (_, Err(e @ Error::Cancelled)) => return Err(e),
+        (Err(e), _) | (_, Err(e)) => {
+            report.fallback = Some(e.to_string());
+            return Ok((maps, Some(report)));
+        }
+    };
+    report.flipped = [gs.flipped, gt.flipped];
+    report.l2_stretch = [gs.l2, gt.l2];
+    let (s2t, t2s) = both(|| gcompose(&gt, &gs, source, rev), || gcompose(&gs, &gt, target, pairs))?;
+    let (s2t, t2s) = match (s2t, t2s) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => {
+            report.fallback = Some(e.to_string());
+            return Ok((maps, Some(report)));
+        }
+    };
+    let g = pair_quality(source, target, &s2t, &t2s)?;
+    report.energy[1] = g.0;
+    report.folded[1] = g.1;
+    report.area_deviation[1] = g.2;
+    if (g.0 < p.0 && g.1 <= p.1 && g.2 < p.2) || opts.force {
+        report.used = true;
+        Ok(((s2t, t2s), Some(report)))
+    } else {
+        report.fallback = Some("the per-patch composition is as good on some count".into());
+        Ok((maps, Some(report)))
+    }
 }

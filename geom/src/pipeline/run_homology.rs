@@ -356,5 +356,6 @@ pub(super) fn pair_report(
         smoothing,
         homology: None,
         features: None,
+        global: None,
     }
 }

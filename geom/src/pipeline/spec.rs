@@ -40,6 +40,9 @@ pub struct MapOptions {
     pub layout: LayoutOptions,
     /// Weights of the patch parameterization (mean value by default).
     pub param: PatchParamOptions,
+    /// The global map onto the base domain that frees vertices from the layout paths (closed
+    /// meshes; on by default). The per-patch maps seed it and stand in when it fails.
+    pub global: crate::crossparam::global::GlobalParamOptions,
     /// Stretch-reducing relocation of vertices across patch boundaries.
     pub smoothing: SmoothOptions,
     /// Re-embedding of regions around folds that the one-vertex repairs leave.
@@ -74,6 +77,7 @@ impl Default for MapOptions {
         Self {
             layout: LayoutOptions::default(),
             param: PatchParamOptions::default(),
+            global: Default::default(),
             smoothing: SmoothOptions::default(),
             untangle: Default::default(),
             metric_samples: 100_000,

@@ -124,7 +124,18 @@ fn gcd(a: u64, b: u64) -> u64 {
 /// A copy twisted about its vertical axis (up to 0.8 rad), same vertex order.
 pub fn twisted(m: &Mesh) -> Mesh {
     let (lo, hi) = m.bbox();
-    let c = P3::from((lo.coords + hi.coords) / 2.0);
+    twisted_about(m, P3::from((lo.coords + hi.coords) / 2.0))
+}
+
+/// [`twisted`] about the vertical line through the vertex centroid, as `bench/table2.py`
+/// deforms (`deform(V, "twist")`).
+pub fn twisted_as_in_the_bench(m: &Mesh) -> Mesh {
+    let sum = m.positions().iter().fold(nalgebra::Vector3::zeros(), |a, p| a + p.coords);
+    twisted_about(m, P3::from(sum / m.n_vertices() as f64))
+}
+
+fn twisted_about(m: &Mesh, c: P3) -> Mesh {
+    let (lo, hi) = m.bbox();
     let pos = m
         .positions()
         .iter()

@@ -1,0 +1,288 @@
+//! A global map of a closed mesh onto the common base domain, with only the anchors fixed
+//! (globally smooth parameterization, Khodakovsky, Litke & Schröder 2003; the coarse-to-fine
+//! cross-parameterization of Schreiner et al. 2004 relaxes patch boundaries the same way).
+//!
+//! The per-patch maps of [`super::patch_param`] hold every vertex of a layout path on its
+//! patch side, so the two meshes' maps meet only where the two meshes' paths happen to lie;
+//! where a target path runs off the true image of its source path (a tail, a finger: up to
+//! 12% of √area on cat poses) the composition squeezes one side and stretches the other.
+//! Here the paths only seed the solve: each vertex is the mean of its neighbours (mean-value
+//! weights, Floater 2003) across patch sides through the charts' transitions ([`charts`]),
+//! vertices that leave their patch are moved to the patch they entered, and the system is
+//! solved again until none moves. Both meshes then depend on the layout's combinatorics and its
+//! anchors alone, not on where its paths were traced.
+
+pub mod charts;
+pub mod links;
+pub mod locate;
+pub mod solve;
+
+use crate::domain::Patch;
+use crate::error::{Error, Result};
+use crate::map::SurfaceMap;
+use crate::mesh::{FaceId, Mesh, VertexId};
+use crate::param::{Uv, stretch_jacobian};
+use charts::Charts;
+use serde::{Deserialize, Serialize};
+use solve::{Rows, State};
+
+/// Options for [`global_param`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct GlobalParamOptions {
+    /// Use the global map (closed meshes); `false` keeps the per-patch maps.
+    pub enabled: bool,
+    /// Solves at most. Vertices that leave their patch are moved to the patch they entered
+    /// and their links carried along, which leaves the system the same, so one solve is
+    /// enough; more re-solve in the new charts (a check: the answer does not change).
+    pub max_solves: usize,
+    /// The patch triangles' shapes.
+    pub metric: DomainMetric,
+    /// Use the global maps whatever their energy (for comparisons).
+    pub force: bool,
+    /// The per-patch composition is kept without trying the global maps when it has no
+    /// folded face and its area ratios are off by at most this much (both directions summed).
+    pub min_area_deviation: f64,
+}
+
+/// How the base domain's patch triangles are shaped ([`charts`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DomainMetric {
+    /// Every patch equilateral.
+    Equilateral,
+    /// Sides as long as the layout paths (mean over both meshes, each scaled by √area).
+    PathLengths,
+}
+
+impl Default for GlobalParamOptions {
+    fn default() -> Self {
+        Self { enabled: true, force: false, min_area_deviation: 0.03, max_solves: 1, metric: DomainMetric::PathLengths }
+    }
+}
+
+/// A mesh mapped onto the base domain.
+pub struct GlobalParam {
+    pub charts: Charts,
+    pub state: State,
+    pub locators: Vec<locate::PatchLocator>,
+    /// Triangles with non-positive area in their first vertex's chart.
+    pub flipped: usize,
+    /// L2 stretch of the map.
+    pub l2: f64,
+    pub residual: f64,
+}
+
+/// Maps `mesh` (closed) onto the base domain of `patches`, anchors (`anchors[k]` is anchor
+/// `k`) fixed at their corners, starting from `init` (per vertex: patch and position in
+/// [`super::TRIANGLE`], e.g. from the per-patch maps); `lengths` per layout path set the
+/// patches' shapes (see [`Charts::new`]); `refined`, the mesh cut along the layout, gives the
+/// links (see [`links`]).
+///
+/// # Errors
+/// `Numerical` when the domain has no cone metric (see [`Charts::new`]) or a solve fails.
+#[allow(clippy::too_many_arguments)]
+pub fn global_param(
+    mesh: &Mesh,
+    patches: &[Patch],
+    anchors: &[VertexId],
+    init: &[(u32, Uv)],
+    refined: Option<&crate::domain::refine::Refined>,
+    lengths: Option<&[f64]>,
+    opts: &GlobalParamOptions,
+    progress: &mut dyn crate::progress::Progress,
+) -> Result<GlobalParam> {
+    let charts = Charts::new(patches, anchors.len(), lengths)?;
+    let n = mesh.n_vertices();
+    if init.len() != n || init.iter().any(|(p, _)| *p as usize >= patches.len()) {
+        return Err(Error::Internal("global map: a vertex without a patch".into()));
+    }
+    let mut st = State {
+        patch: init.iter().map(|x| x.0).collect(),
+        uv: init.iter().map(|&(p, x)| charts.from_canonical(p).apply(x)).collect(),
+        anchor: vec![u32::MAX; n],
+        link: Vec::new(),
+    };
+    let mut fixed = vec![false; n];
+    for (k, a) in anchors.iter().enumerate() {
+        let Some((p, c)) = charts.anchor_home[k] else {
+            return Err(Error::Numerical(format!("anchor {k} is no patch's corner")));
+        };
+        fixed[a.idx()] = true;
+        st.anchor[a.idx()] = k as u32;
+        st.patch[a.idx()] = p;
+        st.uv[a.idx()] = charts.corner[p as usize][c];
+    }
+    let rows = Rows::mean_value(mesh);
+    st.choose_links(&charts, &rows);
+    if let Some(r) = refined {
+        for (s, l) in links::from_refinement(mesh, r, patches, &charts, &st, &rows).into_iter().enumerate() {
+            if l.is_some() {
+                st.link[s] = l;
+            }
+        }
+    }
+    let debug = std::env::var_os("SURFMAP_DEBUG").is_some();
+    let mut system = solve::System::new(&fixed);
+    let residual = relax(&charts, &mut system, &mut st, &fixed, &rows, opts.max_solves)?;
+    progress.check()?;
+    let l2 = vertex_stretch(mesh, &st, &rows, &fixed);
+    if debug {
+        eprintln!("global: harmonic map: folds {} l2 {l2} residual {residual:.2e}", flipped(mesh, &st, &rows, &fixed));
+    }
+    let flipped = flipped(mesh, &st, &rows, &fixed);
+    let locators = locate::locators(mesh, &charts, &st, &rows, &fixed);
+    Ok(GlobalParam { charts, state: st, locators, flipped, l2, residual })
+}
+
+/// Solves, moves vertices into the patches they entered and carries their links along, until
+/// none moves or after `max_solves` solves. Returns the last residual.
+fn relax(
+    charts: &Charts,
+    system: &mut solve::System,
+    st: &mut State,
+    fixed: &[bool],
+    rows: &Rows,
+    max_solves: usize,
+) -> Result<f64> {
+    let mut residual = 0.0;
+    let mut moved_by = vec![None; st.uv.len()];
+    for _ in 0..max_solves.max(1) {
+        let (uv, res) = system.solve(st, fixed, rows)?;
+        residual = res;
+        let mut moved = 0;
+        for v in 0..uv.len() {
+            moved_by[v] = None;
+            if fixed[v] {
+                continue;
+            }
+            let (p, x, m) = charts.settle(st.patch[v], st.uv[v], uv[v]);
+            if p != st.patch[v] {
+                moved += 1;
+                moved_by[v] = Some(m);
+            }
+            st.patch[v] = p;
+            st.uv[v] = x;
+        }
+        if moved == 0 {
+            break;
+        }
+        st.carry_links(rows, &moved_by);
+    }
+    Ok(residual)
+}
+
+/// The face's three chart positions in the chart of its first corner that is not an anchor
+/// (an anchor's chart is its home patch's, which need not be near the face), through the links
+/// of that corner's row.
+pub(crate) fn face_uv(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool], f: FaceId) -> Option<[Uv; 3]> {
+    let t = mesh.face(f);
+    let r = (0..3).find(|&k| !fixed[t[k].idx()]).unwrap_or(0);
+    let i = t[r].idx();
+    let mut out = [st.uv[i]; 3];
+    for k in 0..3 {
+        if k != r {
+            let j = t[k].idx();
+            let s = (rows.start[i]..rows.start[i + 1]).find(|&s| rows.nbr[s].0 as usize == j)?;
+            out[k] = st.neighbour(s, j)?;
+        }
+    }
+    Some(out)
+}
+
+/// Area-weighted L2 stretch (uv scaled to the surface's area); a face without a chart
+/// position or uv area counts as infinitely stretched.
+fn vertex_stretch(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool]) -> f64 {
+    let (mut tn, mut td, mut uv_area) = (0.0, 0.0, 0.0);
+    for f in 0..mesh.n_faces() {
+        let f = FaceId::from_idx(f);
+        let area = mesh.face_area(f);
+        let s2 = face_uv(mesh, st, rows, fixed, f).and_then(|q| {
+            let (ss, stv, a2) = stretch_jacobian(mesh.face_points(f), q)?;
+            uv_area += 0.5 * a2.abs();
+            Some(0.5 * (ss.norm_squared() + stv.norm_squared()))
+        });
+        tn += area * s2.unwrap_or(f64::INFINITY);
+        td += area;
+    }
+    // Scaling uv by k scales the squared stretch by 1 / k²: normalise to equal total areas.
+    (tn * uv_area / td.max(f64::MIN_POSITIVE) / td.max(f64::MIN_POSITIVE)).sqrt()
+}
+
+fn flipped(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool]) -> usize {
+    (0..mesh.n_faces())
+        .filter(|&f| match face_uv(mesh, st, rows, fixed, FaceId::from_idx(f)) {
+            Some(q) => (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]) <= 0.0,
+            None => true,
+        })
+        .count()
+}
+
+/// The map from A's vertices to B's surface through both global maps: each vertex of A is
+/// located at its own chart position in B's locator of the same patch. Anchors go exactly to
+/// their partners.
+///
+/// # Errors
+/// `Numerical` when a patch of B holds no triangle.
+pub fn compose(
+    a: &GlobalParam,
+    b: &GlobalParam,
+    mesh_b: &Mesh,
+    anchors: &[(VertexId, VertexId)],
+) -> Result<SurfaceMap> {
+    let n = a.state.uv.len();
+    let mut face = Vec::with_capacity(n);
+    let mut bary = Vec::with_capacity(n);
+    for v in 0..n {
+        let p = a.state.patch[v];
+        let Some((f, w)) = b.locators[p as usize].locate(a.state.uv[v]) else {
+            return Err(Error::Numerical(format!("patch {p} holds no triangle of the global map")));
+        };
+        face.push(f);
+        bary.push(w);
+    }
+    for &(s, t) in anchors {
+        if let Some(h) = mesh_b.outgoing(t).next() {
+            let mut w = [0.0; 3];
+            w[h.corner()] = 1.0;
+            face[s.idx()] = h.face();
+            bary[s.idx()] = w;
+        }
+    }
+    Ok(SurfaceMap { face, bary })
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::mesh::shapes;
+    use crate::pipeline::{JobSpec, run_map};
+    use crate::progress::NoProgress;
+
+    /// An icosphere onto itself with the icosahedron's twelve vertices as anchors: the layout
+    /// is the icosahedron, both global maps solve the same system with the same links (read
+    /// off two different tracings of the paths), so they agree and the composition is the
+    /// identity; the domain is a cone surface with cones of 300°, and no triangle folds in it.
+    #[test]
+    fn an_icosphere_onto_itself_is_the_identity_through_the_global_maps() {
+        let m = shapes::icosphere(3);
+        let spec: JobSpec = serde_json::from_value(serde_json::json!({
+            "method": "voronoi",
+            "anchors": (0..12).map(|i| [i, i]).collect::<Vec<_>>(),
+            "options": {"metric_samples": 1000, "global": {"force": true}, "smoothing": {"iterations": 0}}
+        }))
+        .unwrap();
+        let (r, arts) = run_map(&spec, &m, &m, &mut NoProgress).unwrap();
+        let g = r.global.unwrap();
+        assert!(g.used);
+        assert_eq!(r.patches, 20);
+        assert_eq!(g.flipped, [0, 0], "no triangle folds in the domain");
+        assert_eq!(g.folded, [0, 0]);
+        // Same system, same answer: the two maps' stretch agrees to rounding.
+        assert!((g.l2_stretch[0] - g.l2_stretch[1]).abs() < 1e-9, "{:?}", g.l2_stretch);
+        let obj = arts.iter().find(|a| a.name == "source_on_target.obj").unwrap();
+        let mapped = crate::io::read(&obj.bytes, &Default::default()).unwrap().mesh;
+        let worst = mapped.positions().iter().zip(m.positions()).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        assert!(worst < 1e-9, "identity up to rounding: {worst}");
+        assert_eq!(r.source_to_target.flipped_faces, 0);
+    }
+}

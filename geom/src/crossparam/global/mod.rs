@@ -40,8 +40,10 @@ pub struct GlobalParamOptions {
     pub metric: DomainMetric,
     /// Use the global maps whatever their energy (for comparisons).
     pub force: bool,
-    /// The per-patch composition is kept without trying the global maps when it has no
-    /// folded face and its area ratios are off by at most this much (both directions summed).
+    /// The per-patch composition is kept without trying the global maps when at most this
+    /// fraction of both meshes' faces are folded in it and its area ratios are off by at most
+    /// `min_area_deviation` (both directions summed).
+    pub min_folded_fraction: f64,
     pub min_area_deviation: f64,
 }
 
@@ -57,7 +59,14 @@ pub enum DomainMetric {
 
 impl Default for GlobalParamOptions {
     fn default() -> Self {
-        Self { enabled: true, force: false, min_area_deviation: 0.03, max_solves: 1, metric: DomainMetric::PathLengths }
+        Self {
+            enabled: true,
+            force: false,
+            min_folded_fraction: 5e-4,
+            min_area_deviation: 0.03,
+            max_solves: 1,
+            metric: DomainMetric::PathLengths,
+        }
     }
 }
 

@@ -56,13 +56,19 @@ pub fn compose(
         face.push(f);
         bary.push(w);
     }
+    let mut map = SurfaceMap { face, bary };
+    place_anchors(&mut map, b, anchors);
+    map
+}
+
+/// Puts each anchor `s` of `map` exactly on its partner `t`, a vertex of `b`.
+pub fn place_anchors(map: &mut SurfaceMap, b: &Mesh, anchors: &[(VertexId, VertexId)]) {
     for &(s, t) in anchors {
         if let Some(h) = b.outgoing(t).next() {
             let mut w = [0.0; 3];
             w[h.corner()] = 1.0;
-            face[s.idx()] = h.face();
-            bary[s.idx()] = w;
+            map.face[s.idx()] = h.face();
+            map.bary[s.idx()] = w;
         }
     }
-    SurfaceMap { face, bary }
 }

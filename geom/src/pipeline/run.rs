@@ -57,9 +57,11 @@ pub struct GlobalReport {
     /// Why the per-patch maps were used instead.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fallback: Option<String>,
-    /// Source and target: triangles folded in the domain and the L2 stretch of their maps.
-    pub flipped: [usize; 2],
+    /// Source and target: triangles folded in the domain, the L2 stretch of their maps and the
+    /// relative residual of their solves.
+    pub domain_folded: [usize; 2],
     pub l2_stretch: [f64; 2],
+    pub residual: [f64; 2],
     /// Per-patch and global composition before smoothing, both directions summed: distortion
     /// energy (symmetric Dirichlet), folded faces, and |area ratio - 1|. The global one is used
     /// when it is better on all three.
@@ -334,8 +336,9 @@ fn choose_global(
     let mut report = GlobalReport {
         used: false,
         fallback: None,
-        flipped: [0; 2],
+        domain_folded: [0; 2],
         l2_stretch: [f64::NAN; 2],
+        residual: [f64::NAN; 2],
         energy: [p.0, f64::NAN],
         folded: [p.1, 0],
         area_deviation: [p.2, f64::NAN],
@@ -374,8 +377,9 @@ fn choose_global(
             return Ok((maps, Some(report)));
         }
     };
-    report.flipped = [gs.flipped, gt.flipped];
+    report.domain_folded = [gs.flipped, gt.flipped];
     report.l2_stretch = [gs.l2, gt.l2];
+    report.residual = [gs.residual, gt.residual];
     let (s2t, t2s) = both(|| gcompose(&gt, &gs, source, rev), || gcompose(&gs, &gt, target, pairs))?;
     let (s2t, t2s) = match (s2t, t2s) {
         (Ok(a), Ok(b)) => (a, b),

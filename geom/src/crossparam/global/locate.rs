@@ -9,8 +9,8 @@ use super::solve::{Rows, State};
 use crate::mesh::{FaceId, Mesh};
 use crate::param::Uv;
 
-/// How far outside the canonical triangle a triangle may lie and still be indexed (chart
-/// units; the triangle's side is 1).
+/// How far outside a patch's triangle another triangle may lie and still be indexed, in
+/// barycentric coordinates of the patch's triangle.
 const MARGIN: f64 = 1e-3;
 
 /// One patch's triangles in its chart.

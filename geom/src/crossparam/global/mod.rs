@@ -7,10 +7,11 @@
 //! where a target path runs off the true image of its source path (a tail, a finger: up to
 //! 12% of √area on cat poses) the composition squeezes one side and stretches the other.
 //! Here the paths only seed the solve: each vertex is the mean of its neighbours (mean-value
-//! weights, Floater 2003) across patch sides through the charts' transitions ([`charts`]),
-//! vertices that leave their patch are moved to the patch they entered, and the system is
-//! solved again until none moves. Both meshes then depend on the layout's combinatorics and its
-//! anchors alone, not on where its paths were traced.
+//! weights, symmetrized, Floater 2003) across patch sides through the *links* between
+//! neighbours' charts ([`charts`], [`links`]); after the solve, vertices that left their patch
+//! are moved to the patch they entered ([`charts::Charts::settle`]). Both meshes then depend on
+//! the layout's combinatorics and its anchors alone, not on where its paths were traced.
+//! [`compose`] carries one mesh to the other through both maps ([`locate`]).
 
 pub mod charts;
 pub mod links;
@@ -79,6 +80,7 @@ pub struct GlobalParam {
     pub flipped: usize,
     /// L2 stretch of the map.
     pub l2: f64,
+    /// Relative residual `‖Ax − b‖ / ‖b‖` of the last solve.
     pub residual: f64,
 }
 
@@ -250,15 +252,9 @@ pub fn compose(
         face.push(f);
         bary.push(w);
     }
-    for &(s, t) in anchors {
-        if let Some(h) = mesh_b.outgoing(t).next() {
-            let mut w = [0.0; 3];
-            w[h.corner()] = 1.0;
-            face[s.idx()] = h.face();
-            bary[s.idx()] = w;
-        }
-    }
-    Ok(SurfaceMap { face, bary })
+    let mut map = SurfaceMap { face, bary };
+    super::compose::place_anchors(&mut map, mesh_b, anchors);
+    Ok(map)
 }
 
 #[cfg(test)]
@@ -284,8 +280,9 @@ mod tests {
         let g = r.global.unwrap();
         assert!(g.used);
         assert_eq!(r.patches, 20);
-        assert_eq!(g.flipped, [0, 0], "no triangle folds in the domain");
+        assert_eq!(g.domain_folded, [0, 0], "no triangle folds in the domain");
         assert_eq!(g.folded, [0, 0]);
+        assert!(g.residual.iter().all(|r| *r < 1e-12), "solver residuals {:?}", g.residual);
         // Same system, same answer: the two maps' stretch agrees to rounding.
         assert!((g.l2_stretch[0] - g.l2_stretch[1]).abs() < 1e-9, "{:?}", g.l2_stretch);
         let obj = arts.iter().find(|a| a.name == "source_on_target.obj").unwrap();

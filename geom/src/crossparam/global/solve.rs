@@ -2,7 +2,8 @@
 //! weighted mean of its neighbours, each neighbour expressed in the vertex's own chart through
 //! the transition between their patches (a connection Laplacian with rigid transitions, as in
 //! Khodakovsky, Litke & Schröder 2003). Anchors are fixed at their corners. The system couples
-//! the two coordinates (the transitions rotate), so it is one sparse `2n × 2n` LU (faer).
+//! the two coordinates (the transitions rotate): one sparse `2n × 2n` Cholesky (faer), see
+//! [`System`].
 
 use super::charts::{Affine, Charts};
 use crate::error::{Error, Result};

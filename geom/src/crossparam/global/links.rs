@@ -15,8 +15,8 @@ use crate::mesh::{FaceId, HalfedgeId, Mesh, VertexId};
 use std::collections::HashMap;
 
 /// Per slot of `rows`: the link of that ordered pair from the faces of `r` (the refinement of
-/// `mesh` along the layout), or `None` where the refinement cannot say (the caller keeps the
-/// distance-chosen link there).
+/// `mesh` along the layout), or `None` where the refinement cannot say (the caller chooses
+/// those by distance, [`State::fill_links`]).
 pub fn from_refinement(
     mesh: &Mesh,
     r: &Refined,

@@ -125,14 +125,11 @@ pub fn global_param(
         st.uv[a.idx()] = charts.corner[p as usize][c];
     }
     let rows = Rows::mean_value(mesh);
-    st.choose_links(&charts, &rows);
+    // Links from the refinement; by distance only where it cannot tell.
     if let Some(r) = refined {
-        for (s, l) in links::from_refinement(mesh, r, patches, &charts, &st, &rows).into_iter().enumerate() {
-            if l.is_some() {
-                st.link[s] = l;
-            }
-        }
+        st.link = links::from_refinement(mesh, r, patches, &charts, &st, &rows);
     }
+    st.fill_links(&charts, &rows);
     let debug = std::env::var_os("SURFMAP_DEBUG").is_some();
     let mut system = solve::System::new(&fixed);
     let residual = relax(&charts, &mut system, &mut st, &fixed, &rows, opts.max_solves)?;
@@ -194,7 +191,7 @@ pub(crate) fn face_uv(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool], f: F
     for k in 0..3 {
         if k != r {
             let j = t[k].idx();
-            let s = (rows.start[i]..rows.start[i + 1]).find(|&s| rows.nbr[s].0 as usize == j)?;
+            let s = solve::slot_of(rows, i, j)?;
             out[k] = st.neighbour(s, j)?;
         }
     }

@@ -29,12 +29,16 @@ pub struct State {
 }
 
 impl State {
-    /// Links for every slot of `rows`, each on the sheet that puts the neighbour closest to the
-    /// vertex (an anchor: at its corner whenever the vertex's patch has it).
-    pub fn choose_links(&mut self, charts: &Charts, rows: &Rows) {
-        self.link = vec![None; rows.nbr.len()];
+    /// Fills every slot of `rows` without a link (all of them when `link` is empty) with the
+    /// link on the sheet that puts the neighbour closest to the vertex (an anchor: at its
+    /// corner whenever the vertex's patch has it).
+    pub fn fill_links(&mut self, charts: &Charts, rows: &Rows) {
+        self.link.resize(rows.nbr.len(), None);
         for i in 0..self.uv.len() {
             for s in rows.start[i]..rows.start[i + 1] {
+                if self.link[s].is_some() {
+                    continue;
+                }
                 let j = rows.nbr[s].0 as usize;
                 let (p, x) = (self.patch[i], self.uv[i]);
                 self.link[s] = match self.anchor[j] {
@@ -104,7 +108,7 @@ impl Rows {
             .flat_map(|i| (rows.start[i]..rows.start[i + 1]).map(move |s| (i, s)))
             .map(|(i, s)| {
                 let (j, w) = rows.nbr[s];
-                reverse_slot(&rows, j as usize, i).map_or(w, |r| 0.5 * (w + rows.nbr[r].1))
+                slot_of(&rows, j as usize, i).map_or(w, |r| 0.5 * (w + rows.nbr[r].1))
             })
             .collect();
         for (x, w) in rows.nbr.iter_mut().zip(sym) {
@@ -166,11 +170,8 @@ impl System {
                 let (j, w) = rows.nbr[s];
                 let j = j as usize;
                 // One link per edge: the smaller end's, inverted for the larger end.
-                let link = if i < j {
-                    st.link[s]
-                } else {
-                    reverse_slot(rows, j, i).and_then(|r| st.link[r]).map(|a| a.inverse())
-                };
+                let link =
+                    if i < j { st.link[s] } else { slot_of(rows, j, i).and_then(|r| st.link[r]).map(|a| a.inverse()) };
                 let Some(a) = link else {
                     continue;
                 };
@@ -236,6 +237,6 @@ impl System {
 }
 
 /// The slot of `j` in `i`'s row.
-pub fn reverse_slot(rows: &Rows, i: usize, j: usize) -> Option<usize> {
+pub fn slot_of(rows: &Rows, i: usize, j: usize) -> Option<usize> {
     (rows.start[i]..rows.start[i + 1]).find(|&s| rows.nbr[s].0 as usize == j)
 }

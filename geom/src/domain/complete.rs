@@ -89,6 +89,54 @@ fn disconnects(t: &Tracer, p: u32) -> bool {
         || super::uf_find(&mut parent, q.a as usize) != super::uf_find(&mut parent, q.b as usize)
 }
 
+/// For `SURFMAP_DEBUG`: the layout's census before each completion step. `V − E + W − χ` is
+/// twice the number of regions that are not disks (an annulus left around a handle adds 2),
+/// and the open walks name the regions still to split.
+fn census(t: &Tracer, ws: &[super::walks::Walk], chi: i64) {
+    let (v, e) = (t.anchors().len() as i64, t.paths().len() as i64);
+    let open: Vec<Vec<u32>> = ws.iter().filter(|w| !w.is_triangle(t)).map(|w| w.corners(t)).collect();
+    eprintln!(
+        "complete: V {v} E {e} W {} (V - E + W - chi = {}) open walks {open:?}",
+        ws.len(),
+        v - e + ws.len() as i64 - chi
+    );
+}
+
+/// Joins two walks of one region (which must then not be a disk) by the shortest traceable
+/// path between corners of theirs (distinct anchors); candidates nearest first, until
+/// `max_attempts` traces in all.
+fn join_walks(
+    ts: &mut [&mut Tracer],
+    ws: &[super::walks::Walk],
+    max_attempts: usize,
+    stats: &mut CompleteStats,
+) -> Result<bool> {
+    type End = (usize, usize);
+    let t0: &Tracer = ts[0];
+    let mut cand: Vec<(f64, End, End)> = Vec::new();
+    for (wi, w) in ws.iter().enumerate() {
+        for (wj, x) in ws.iter().enumerate().skip(wi + 1) {
+            for (ci, &a) in w.corners(t0).iter().enumerate() {
+                for (cj, &b) in x.corners(t0).iter().enumerate() {
+                    if a != b {
+                        cand.push((dist(t0, a, b), (wi, ci), (wj, cj)));
+                    }
+                }
+            }
+        }
+    }
+    cand.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (_, e1, e2) in cand {
+        if stats.attempts > max_attempts {
+            break;
+        }
+        if try_link(ts, [e1, e2], stats)? {
+            return Ok(true);
+        }
+    }
+    Ok(false)
+}
+
 /// Adds paths until every region is a triangle and the layout is cellular (`V - E + W = χ`).
 ///
 /// # Errors
@@ -121,6 +169,9 @@ pub fn complete(
             .into());
         }
         let ws = walks(t0);
+        if std::env::var_os("SURFMAP_DEBUG").is_some() {
+            census(t0, &ws, chi);
+        }
         // 1. Split non-triangular walks by their shortest admissible diagonal.
         for (wi, w) in ws.iter().enumerate() {
             if w.is_triangle(t0) {
@@ -207,27 +258,8 @@ pub fn complete(
         if na - t0.paths().len() as i64 + ws.len() as i64 == chi {
             return Ok(stats);
         }
-        type End = (usize, usize);
-        let mut cand: Vec<(f64, End, End)> = Vec::new();
-        for (wi, w) in ws.iter().enumerate() {
-            for (wj, x) in ws.iter().enumerate().skip(wi + 1) {
-                for (ci, &a) in w.corners(t0).iter().enumerate() {
-                    for (cj, &b) in x.corners(t0).iter().enumerate() {
-                        if a != b {
-                            cand.push((dist(t0, a, b), (wi, ci), (wj, cj)));
-                        }
-                    }
-                }
-            }
-        }
-        cand.sort_by(|a, b| a.0.total_cmp(&b.0));
-        for (_, e1, e2) in cand {
-            if stats.attempts > max_attempts {
-                break;
-            }
-            if try_link(ts, [e1, e2], &mut stats)? {
-                continue 'outer;
-            }
+        if join_walks(ts, &ws, max_attempts, &mut stats)? {
+            continue 'outer;
         }
         return Err(InputError::LayoutConflict(
             "the layout does not cut the surface into disks and no joining path could be traced".into(),

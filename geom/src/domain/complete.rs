@@ -89,16 +89,23 @@ fn disconnects(t: &Tracer, p: u32) -> bool {
         || super::uf_find(&mut parent, q.a as usize) != super::uf_find(&mut parent, q.b as usize)
 }
 
-/// For `SURFMAP_DEBUG`: the layout's census before each completion step. `V − E + W − χ` is
-/// twice the number of regions that are not disks (an annulus left around a handle adds 2),
-/// and the open walks name the regions still to split.
+/// `V − E + W − χ` of the layout with walks `ws`. A region of genus `g` bounded by `b` walks
+/// adds `2 (b − 1 + g)` (an annulus left around a handle adds 2, a disk nothing), so it is 0
+/// exactly when every region is a disk (for a connected layout graph).
+fn excess(t: &Tracer, ws: &[super::walks::Walk], chi: i64) -> i64 {
+    t.anchors().len() as i64 - t.paths().len() as i64 + ws.len() as i64 - chi
+}
+
+/// For `SURFMAP_DEBUG`: the layout's census before each completion step, [`excess`] and the
+/// open walks (the regions still to split).
 fn census(t: &Tracer, ws: &[super::walks::Walk], chi: i64) {
-    let (v, e) = (t.anchors().len() as i64, t.paths().len() as i64);
     let open: Vec<Vec<u32>> = ws.iter().filter(|w| !w.is_triangle(t)).map(|w| w.corners(t)).collect();
     eprintln!(
-        "complete: V {v} E {e} W {} (V - E + W - chi = {}) open walks {open:?}",
+        "complete: V {} E {} W {} (V - E + W - chi = {}) open walks {open:?}",
+        t.anchors().len(),
+        t.paths().len(),
         ws.len(),
-        v - e + ws.len() as i64 - chi
+        excess(t, ws, chi)
     );
 }
 
@@ -253,9 +260,7 @@ pub fn complete(
             .into());
         }
         // 2. All triangles: if the layout is not cellular, join two walks of one region.
-        let t0: &Tracer = ts[0];
-        let na = t0.anchors().len() as i64;
-        if na - t0.paths().len() as i64 + ws.len() as i64 == chi {
+        if excess(ts[0], &ws, chi) == 0 {
             return Ok(stats);
         }
         if join_walks(ts, &ws, max_attempts, &mut stats)? {
@@ -272,6 +277,26 @@ pub fn complete(
 mod tests {
     use super::*;
     use crate::mesh::{VertexId, shapes};
+
+    #[test]
+    fn excess_counts_regions_that_are_not_disks() {
+        // A triangle of paths on a sphere: two disks.
+        let m = shapes::icosphere(3);
+        let mut t = Tracer::new(&m, &[VertexId(0), VertexId(5), VertexId(11)], &Default::default()).unwrap();
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            t.trace_insert(&TraceRequest { a, b, ..Default::default() }).unwrap().unwrap();
+        }
+        assert_eq!(excess(&t, &walks(&t), 2), 0);
+        // The same on a torus: one disk, and a one-holed torus (b = 1, g = 1) adds 2.
+        let m = shapes::torus(24, 12, 1.0, 0.4);
+        let anchors = [VertexId(0), VertexId(2), VertexId(2 * 12 + 1)];
+        let mut t = Tracer::new(&m, &anchors, &Default::default()).unwrap();
+        for (a, b) in [(0, 1), (1, 2), (2, 0)] {
+            t.trace_insert(&TraceRequest { a, b, ..Default::default() }).unwrap().unwrap();
+        }
+        assert_eq!(walks(&t).len(), 2);
+        assert_eq!(excess(&t, &walks(&t), 0), 2);
+    }
 
     #[test]
     fn bridges_and_last_paths_are_not_ripped() {

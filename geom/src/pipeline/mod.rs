@@ -3,6 +3,7 @@
 //! artifacts wherever they keep them.
 
 mod artifacts;
+mod global_choice;
 mod job;
 mod remesh_spec;
 mod run;

@@ -52,12 +52,34 @@ pub struct RelaxedComparison {
 pub const RELAXED_AREA_SLACK: f64 = 0.01;
 
 impl RelaxedComparison {
+    /// From [`relaxed_quality`] of the per-patch maps `p` and the global maps `g`, each
+    /// (source to target, target to source).
+    pub(super) fn new(p: [(f64, usize, f64); 2], g: [(f64, usize, f64); 2]) -> Self {
+        Self {
+            l2_stretch: [p[0].0 + p[1].0, g[0].0 + g[1].0],
+            folded: [p[0].1 + p[1].1, g[0].1 + g[1].1],
+            area_deviation: [p[0].2 + p[1].2, g[0].2 + g[1].2],
+        }
+    }
+
     /// The global maps fold no more, stretch less and are off in area by at most
     /// [`RELAXED_AREA_SLACK`] more.
     pub fn prefers_global(&self) -> bool {
         self.folded[1] <= self.folded[0]
             && self.l2_stretch[1] < self.l2_stretch[0]
             && self.area_deviation[1] <= self.area_deviation[0] + RELAXED_AREA_SLACK
+    }
+}
+
+impl GlobalReport {
+    /// Records the comparison after relaxation and the choice it makes; returns whether the
+    /// global maps are used.
+    pub(super) fn record_relaxed(&mut self, cmp: RelaxedComparison) -> bool {
+        let global = cmp.prefers_global();
+        self.relaxed = Some(cmp);
+        self.used = global;
+        self.fallback = (!global).then(|| "the per-patch maps are as good after relaxation".into());
+        global
     }
 }
 

@@ -291,21 +291,8 @@ pub fn run_map(
             )?;
             let ((ps, gs, qps, qgs), (pt, gt, qpt, qgt)) = (x?, y?);
             clock.lap("smooth");
-            let cmp = RelaxedComparison {
-                l2_stretch: [qps.0 + qpt.0, qgs.0 + qgt.0],
-                folded: [qps.1 + qpt.1, qgs.1 + qgt.1],
-                area_deviation: [qps.2 + qpt.2, qgs.2 + qgt.2],
-            };
-            let use_global = cmp.prefers_global();
-            if let Some(r) = global_report.as_mut() {
-                r.relaxed = Some(cmp);
-                if use_global {
-                    r.used = true;
-                    r.fallback = None;
-                } else {
-                    r.fallback = Some("the per-patch maps are as good after relaxation".into());
-                }
-            }
+            let cmp = RelaxedComparison::new([qps, qpt], [qgs, qgt]);
+            let use_global = global_report.as_mut().map_or(cmp.prefers_global(), |r| r.record_relaxed(cmp));
             let ((s2t, r1), (t2s, r2)) = if use_global { (gs, gt) } else { (ps, pt) };
             let measure = |from: &Mesh,
                            to: &Mesh,

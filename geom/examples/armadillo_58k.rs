@@ -3,6 +3,8 @@
 //! subdivided once), `coarse.obj` (a 6k-vertex simplification) and `anchors.json` (45 farthest
 //! points of the coarse mesh and their partners, as `benches/map.rs` picks them), then
 //! `surfmap map DIR/fine.obj DIR/coarse.obj --anchors DIR/anchors.json --out OUT`.
+//! It also writes the benchmark's other case: `armadillo.obj`, `bent.obj` and `bent_anchors.json`
+//! (45 farthest points), for `surfmap map DIR/armadillo.obj DIR/bent.obj --anchors DIR/bent_anchors.json`.
 use std::path::{Path, PathBuf};
 
 #[path = "../benches/common/mod.rs"]
@@ -30,5 +32,9 @@ fn run(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let anchors: Vec<[u64; 2]> =
         common::fps(&coarse.mesh, 45).into_iter().map(|a| [u64::from(coarse.kept[a as usize].0), a]).collect();
     std::fs::write(dir.join("anchors.json"), format!("{{\"anchors\": {anchors:?}}}"))?;
+    geom::io::write_path(&s, &dir.join("armadillo.obj"))?;
+    geom::io::write_path(&common::bent(&s), &dir.join("bent.obj"))?;
+    let anchors: Vec<[u64; 2]> = common::fps(&s, 45).into_iter().map(|a| [a, a]).collect();
+    std::fs::write(dir.join("bent_anchors.json"), format!("{{\"anchors\": {anchors:?}}}"))?;
     Ok(())
 }

@@ -14,19 +14,20 @@ pub fn flipped_faces(mapped: &Mesh, target: &Mesh, index: &SurfaceIndex, vertex_
             n / n.norm().max(crate::tol::TINY)
         })
         .collect();
-    let cents: Vec<_> = (0..mapped.n_faces()).map(|f| centroid(mapped.face_points(FaceId::from_idx(f)))).collect();
+    let opposes = |nm: &crate::mesh::V3, g: FaceId| nm.dot(&tn[g.idx()]) < 0.0;
+    // The centroid's nearest face is looked up only for faces already opposed at all three
+    // corners (a quarter of the searches otherwise); the count is the same.
+    let suspects: Vec<usize> = (0..mapped.n_faces())
+        .filter(|&fi| {
+            let nm = mapped.face_normal_raw(FaceId::from_idx(fi));
+            mapped.faces()[fi].iter().all(|v| opposes(&nm, vertex_nearest[v.idx()].face))
+        })
+        .collect();
+    let cents: Vec<_> = suspects.iter().map(|&f| centroid(mapped.face_points(FaceId::from_idx(f)))).collect();
     let at_centroid = index.query_all(&cents);
     let mut count = 0;
-    for (fi, f) in mapped.faces().iter().enumerate() {
-        let fid = FaceId::from_idx(fi);
-        let nm = mapped.face_normal_raw(fid);
-        let under = [
-            at_centroid[fi].face,
-            vertex_nearest[f[0].idx()].face,
-            vertex_nearest[f[1].idx()].face,
-            vertex_nearest[f[2].idx()].face,
-        ];
-        if under.iter().all(|g| nm.dot(&tn[g.idx()]) < 0.0) {
+    for (&fi, c) in suspects.iter().zip(&at_centroid) {
+        if opposes(&mapped.face_normal_raw(FaceId::from_idx(fi)), c.face) {
             count += 1;
         }
     }

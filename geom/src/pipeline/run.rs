@@ -89,7 +89,10 @@ pub(super) fn finish_direction(
 }
 
 /// One direction's relaxation: stretch-reducing smoothing, visibility under the evaluator's
-/// rules, fold repair, re-embedding and boundary sliding.
+/// rules, fold repair, re-embedding and boundary sliding. When the smoothing's area reward
+/// leaves faces folded (opposed to the target at all three corners, a superset of the
+/// evaluator's flips), the relaxation is run again without it and the map with fewer folds is
+/// kept (the first on a tie).
 pub(super) fn relax_direction(
     from: &Mesh,
     to: &Mesh,
@@ -98,7 +101,29 @@ pub(super) fn relax_direction(
     o: &super::spec::MapOptions,
     progress: &mut dyn Progress,
 ) -> Result<(SurfaceMap, smooth::SmoothReport)> {
-    let (mut m, r) = smooth::smooth(from, to, map, fixed, &o.smoothing, progress)?;
+    if o.smoothing.area_weight == 0.0 {
+        return relax_with(from, to, map, fixed, o, &o.smoothing, progress);
+    }
+    let first = relax_with(from, to, map.clone(), fixed, o, &o.smoothing, progress)?;
+    let folded = smooth::map_quality(from, to, &first.0).flipped;
+    if folded == 0 {
+        return Ok(first);
+    }
+    let plain = smooth::SmoothOptions { area_weight: 0.0, ..o.smoothing };
+    let second = relax_with(from, to, map, fixed, o, &plain, progress)?;
+    Ok(if smooth::map_quality(from, to, &second.0).flipped < folded { second } else { first })
+}
+
+fn relax_with(
+    from: &Mesh,
+    to: &Mesh,
+    map: SurfaceMap,
+    fixed: &[VertexId],
+    o: &super::spec::MapOptions,
+    so: &smooth::SmoothOptions,
+    progress: &mut dyn Progress,
+) -> Result<(SurfaceMap, smooth::SmoothReport)> {
+    let (mut m, r) = smooth::smooth(from, to, map, fixed, so, progress)?;
     let mut v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed, true)?;
     let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed, false)?;
     let untangled = crate::crossparam::untangle::untangle(from, to, &mut m, fixed, &o.untangle)?;

@@ -37,6 +37,7 @@ pub struct FoldoverFreeOptions {
     /// `pace_rounds` rounds, would still be negative after the last round gives up: tangles
     /// that creep towards zero by a percent a round otherwise run every round in vain.
     pub hopeless_round: usize,
+    /// Rounds over which that pace is measured.
     pub pace_rounds: usize,
     /// Rounds that keep lowering the energy once every triangle is valid, at most.
     pub valid_rounds: usize,

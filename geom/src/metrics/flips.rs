@@ -16,7 +16,7 @@ pub fn flipped_faces(mapped: &Mesh, target: &Mesh, index: &SurfaceIndex, vertex_
         .collect();
     let opposes = |nm: &crate::mesh::V3, g: FaceId| nm.dot(&tn[g.idx()]) < 0.0;
     // The centroid's nearest face is looked up only for faces already opposed at all three
-    // corners (a quarter of the searches otherwise); the count is the same.
+    // corners, instead of for every face; the count is the same.
     let suspects: Vec<usize> = (0..mapped.n_faces())
         .filter(|&fi| {
             let nm = mapped.face_normal_raw(FaceId::from_idx(fi));

@@ -229,6 +229,12 @@ impl JobSpec {
         {
             return Err(InputError::Spec(format!("options.dihedral_threshold_deg must be in (0, 180], got {d}")).into());
         }
+        let w = self.options.smoothing.area_weight;
+        if !(w.is_finite() && w >= 0.0) {
+            return Err(
+                InputError::Spec(format!("options.smoothing.area_weight must be finite and >= 0, got {w}")).into()
+            );
+        }
         if self.features.len() > MAX_FEATURES {
             return Err(InputError::Features(format!(
                 "{} feature curves exceed the limit {MAX_FEATURES}",
@@ -288,5 +294,27 @@ impl JobSpec {
             out.push((VertexId(s as u32), VertexId(t as u32)));
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+
+    #[test]
+    fn a_negative_area_weight_is_a_spec_error() {
+        let m = shapes::icosphere(1);
+        let mut spec = JobSpec {
+            method: Method::Voronoi,
+            anchors: vec![[0, 0], [3, 3], [7, 7]],
+            features: Vec::new(),
+            options: MapOptions::default(),
+        };
+        assert!(spec.validate(&m, &m).is_ok());
+        spec.options.smoothing.area_weight = -1.0;
+        let e = spec.validate(&m, &m).unwrap_err();
+        assert_eq!(e.code(), "invalid_spec", "{e}");
+        assert!(e.to_string().contains("area_weight"), "{e}");
     }
 }

@@ -223,6 +223,9 @@ pub fn smooth(
     let mut img_face: Vec<FaceId> = map.face.clone();
     // Chord-area reward per unit of cross-product length: half the weight times the scale squared.
     let aw = 0.5 * opts.area_weight * scale * scale;
+    // One face's share of a star's objective: its energy minus the area reward.
+    let face_term =
+        |fr: &SourceFrame, m: [P3; 3], nm: V3| -> Option<f64> { Some(fr.energy(m, scale)? - aw * nm.norm()) };
     let frames: Vec<Option<SourceFrame>> =
         (0..source.n_faces()).map(|f| SourceFrame::new(source.face_points(FaceId::from_idx(f)))).collect();
     let star_energy = |v: VertexId, pos: &[P3], img_face: &[FaceId], p: P3, f: FaceId| -> Option<f64> {
@@ -239,7 +242,7 @@ pub fn smooth(
             if nm.dot(&tnormal(f)) <= 0.0 {
                 return None;
             }
-            e += frames[h.face().idx()]?.energy(m, scale)? - aw * nm.norm();
+            e += face_term(frames[h.face().idx()].as_ref()?, m, nm)?;
         }
         Some(e)
     };
@@ -279,7 +282,7 @@ pub fn smooth(
             for he in source.outgoing(v) {
                 let tri = source.face(he.face());
                 let m = tri.map(|w| if w == v { q } else { pos[w.idx()] });
-                sum += frames[he.face().idx()]?.energy(m, scale)? - aw * (m[1] - m[0]).cross(&(m[2] - m[0])).norm();
+                sum += face_term(frames[he.face().idx()].as_ref()?, m, (m[1] - m[0]).cross(&(m[2] - m[0])))?;
             }
             Some(sum)
         };

@@ -114,6 +114,7 @@ pub(super) fn relax_direction(
     Ok(if smooth::map_quality(from, to, &second.0).flipped < folded { second } else { first })
 }
 
+/// [`relax_direction`] with the given smoothing options.
 fn relax_with(
     from: &Mesh,
     to: &Mesh,

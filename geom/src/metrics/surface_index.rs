@@ -17,6 +17,9 @@ const SEARCH_RUN: usize = 8192;
 /// Candidates per query, as in the evaluator.
 pub const CANDIDATES: usize = 24;
 
+/// Most points answered from one radius search (see `search_in_order`).
+const BLOCK: usize = 64;
+
 /// A k-nearest-centroid surface index.
 pub struct SurfaceIndex<'m> {
     mesh: &'m Mesh,
@@ -24,6 +27,8 @@ pub struct SurfaceIndex<'m> {
     k: NonZeroUsize,
     /// Per face, an upper bound on the distance from its centroid to its points.
     radius: Vec<f64>,
+    /// Face centroids, as in the tree.
+    centroids: Vec<[f64; 3]>,
 }
 
 /// One query's answer.
@@ -108,7 +113,7 @@ impl<'m> SurfaceIndex<'m> {
         let tree = ImmutableKdTree::new_from_slice(&cents).map_err(|e| Error::Internal(format!("k-d tree: {e:?}")))?;
         let k = NonZeroUsize::new(CANDIDATES.min(mesh.n_faces()))
             .ok_or_else(|| Error::Internal("mesh has no faces".into()))?;
-        Ok(Self { mesh, tree, k, radius })
+        Ok(Self { mesh, tree, k, radius, centroids: cents })
     }
 
     /// The distances of [`SurfaceIndex::query`] for `pts`, visited in `order` (nearby points in
@@ -144,24 +149,41 @@ impl<'m> SurfaceIndex<'m> {
             .par_chunks(SEARCH_RUN)
             .flat_map_iter(|run| {
                 let mut out = Vec::with_capacity(run.len());
-                self.search_in_order(pts, run, sorted, |i, n| out.push((i, n)));
+                // The run's points copied in visiting order: the searches read them in sequence.
+                let local: Vec<P3> = run.iter().map(|&i| pts[i]).collect();
+                self.search_in_order(&local, sorted, |k, n| out.push((run[k], n)));
                 out
             })
             .collect()
     }
 
-    /// Runs the candidate search for `pts` in `order`, handing each answer to `put`. Each
-    /// search is bounded by the previous point's k-th candidate distance plus the step between
-    /// the points: by the triangle inequality at least k centroids lie inside, so the candidate
-    /// set is that of an unbounded search. One scratch buffer serves every search.
-    fn search_in_order(&self, pts: &[P3], order: &[usize], sorted: bool, mut put: impl FnMut(usize, Nearest)) {
+    /// Runs the candidate search for `pts` in their order (nearby points in turn), handing each
+    /// answer to `put` with the point's index.
+    ///
+    /// Queries are taken in blocks of nearby points. The block's first point `p0` gets a k-d
+    /// tree search (bounded by the previous point's k-th candidate distance plus the step
+    /// between the points: by the triangle inequality at least k centroids lie inside, so the
+    /// candidate set is that of an unbounded search). Its k-th distance `dk` admits into the
+    /// block the following points within `dk / 2` of `p0` (at most [`BLOCK`]); one radius search
+    /// then gathers every centroid within `dk + 2ρ` of `p0`, ρ the block's reach. A block point
+    /// `q` has its k nearest within `dk(q) ≤ dk + |q − p0|` of itself, so within `dk + 2ρ` of
+    /// `p0`: its k nearest of that gathered set (at most about 4k centroids on a surface) are its
+    /// k nearest overall, and the tree is searched once per block instead of once per point.
+    fn search_in_order(&self, pts: &[P3], sorted: bool, mut put: impl FnMut(usize, Nearest)) {
         let mut scratch = self.tree.create_scratch::<SquaredEuclidean<f64>>();
         let mut hint: Option<(P3, f64)> = None;
-        for &i in order {
-            let p = &pts[i];
-            let q = [p.x, p.y, p.z];
+        let mut gathered: Vec<([f64; 3], u32)> = Vec::new();
+        let mut cand: Vec<(f64, u32)> = Vec::new();
+        let mut d2: Vec<f64> = Vec::new();
+        let mut kth_buf: Vec<f64> = Vec::new();
+        let k = self.k.get();
+        let mut start = 0;
+        while start < pts.len() {
+            let i = start;
+            let p0 = pts[i];
+            let q = [p0.x, p0.y, p0.z];
             let bounded = hint.and_then(|(prev, dk)| {
-                let r = (dk + (p - prev).norm()) * (1.0 + 1e-9);
+                let r = (dk + (p0 - prev).norm()) * (1.0 + 1e-9);
                 let query = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).within(r * r);
                 let c = if sorted {
                     query.with_scratch(&mut scratch).execute()
@@ -169,9 +191,9 @@ impl<'m> SurfaceIndex<'m> {
                     query.unsorted().with_scratch(&mut scratch).execute()
                 };
                 // Always k by the triangle inequality; the fallback only guards degenerate input.
-                (c.len() == self.k.get()).then_some(c)
+                (c.len() == k).then_some(c)
             });
-            let cand = match bounded {
+            let first = match bounded {
                 Some(c) => c,
                 None => {
                     let query = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k);
@@ -182,11 +204,64 @@ impl<'m> SurfaceIndex<'m> {
                     }
                 }
             };
-            let dk = cand.iter().map(|n| n.distance).fold(f64::NEG_INFINITY, f64::max);
-            if dk.is_finite() {
-                hint = Some((*p, dk.sqrt()));
+            put(i, self.best_of(&p0, first.iter().map(|n| (n.item, n.distance))));
+            let dk = first.iter().map(|n| n.distance).fold(f64::NEG_INFINITY, f64::max).sqrt();
+            start += 1;
+            if !dk.is_finite() {
+                hint = None;
+                continue;
             }
-            put(i, self.best_of(p, cand.iter().map(|n| (n.item, n.distance))));
+            hint = Some((p0, dk));
+            // The block: following points within dk / 2 of p0.
+            let mut end = start;
+            let mut reach: f64 = 0.0;
+            while end < pts.len() && end - start < BLOCK {
+                let d = (pts[end] - p0).norm();
+                if d > 0.5 * dk {
+                    break;
+                }
+                reach = reach.max(d);
+                end += 1;
+            }
+            if end == start {
+                continue;
+            }
+            let r = (dk + 2.0 * reach) * (1.0 + 1e-9);
+            let ball = self.tree.query(&q).within::<SquaredEuclidean<f64>>(r * r).unsorted().execute();
+            gathered.clear();
+            gathered.extend(ball.iter().map(|n| (self.centroids[n.item as usize], n.item)));
+            for (j, &p) in pts.iter().enumerate().take(end).skip(start) {
+                d2.clear();
+                d2.extend(gathered.iter().map(|(c, _)| {
+                    let (dx, dy, dz) = (c[0] - p.x, c[1] - p.y, c[2] - p.z);
+                    dx * dx + dy * dy + dz * dz
+                }));
+                // The k-th smallest squared distance: the candidates are those not beyond it.
+                let kth = if d2.len() > k {
+                    kth_buf.clear();
+                    kth_buf.extend_from_slice(&d2);
+                    *kth_buf.select_nth_unstable_by(k - 1, f64::total_cmp).1
+                } else {
+                    d2.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                };
+                let best = if sorted {
+                    cand.clear();
+                    cand.extend(d2.iter().zip(&gathered).filter(|(d, _)| **d <= kth).map(|(d, g)| (*d, g.1)));
+                    cand.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+                    cand.truncate(k);
+                    self.best_of(&p, cand.iter().map(|&(d, item)| (item, d)))
+                } else {
+                    // The nearest centroid first: its distance prunes most of the others.
+                    let near = (0..d2.len()).min_by(|&a, &b| d2[a].total_cmp(&d2[b])).unwrap_or(0);
+                    let rest = (0..d2.len()).filter(|&c| c != near && d2[c] <= kth);
+                    self.best_of(&p, std::iter::once(near).chain(rest).map(|c| (gathered[c].1, d2[c])))
+                };
+                put(j, best);
+                if d2.len() >= k {
+                    hint = Some((p, kth.sqrt()));
+                }
+            }
+            start = end;
         }
     }
 

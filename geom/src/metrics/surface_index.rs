@@ -228,6 +228,10 @@ impl<'m> SurfaceIndex<'m> {
             }
             let r = (dk + 2.0 * reach) * (1.0 + 1e-9);
             let ball = self.tree.query(&q).within::<SquaredEuclidean<f64>>(r * r).unsorted().execute();
+            if ball.len() < k {
+                // Never by the triangle inequality; degenerate input takes one search per point.
+                continue;
+            }
             gathered.clear();
             gathered.extend(ball.iter().map(|n| (self.centroids[n.item as usize], n.item)));
             for (j, &p) in pts.iter().enumerate().take(end).skip(start) {
@@ -236,7 +240,8 @@ impl<'m> SurfaceIndex<'m> {
                     let (dx, dy, dz) = (c[0] - p.x, c[1] - p.y, c[2] - p.z);
                     dx * dx + dy * dy + dz * dz
                 }));
-                // The k-th smallest squared distance: the candidates are those not beyond it.
+                // The k-th smallest squared distance: the candidates are those not beyond it
+                // (every centroid tied at exactly that distance is admitted).
                 let kth = if d2.len() > k {
                     kth_buf.clear();
                     kth_buf.extend_from_slice(&d2);
@@ -326,6 +331,32 @@ mod tests {
         let d = idx.distances_in_order(&pts, &order);
         for (i, p) in pts.iter().enumerate() {
             assert_eq!(d[i], idx.query(p).distance, "query {i}");
+        }
+    }
+
+    #[test]
+    fn block_answers_equal_plain_queries() {
+        // A slow walk inside and outside the sphere: consecutive points are close, so most are
+        // answered from a block's radius search, and far from the surface the candidate set
+        // decides the answer.
+        let s = shapes::icosphere(2);
+        let idx = SurfaceIndex::new(&s).unwrap();
+        let pts: Vec<P3> = (0..6000)
+            .map(|i| {
+                // Off the sphere's symmetry planes and axes (no ties between faces).
+                let t = 0.1 + f64::from(i) * 0.012;
+                let r = 0.4 + 1.2 * (t * 1.3).sin().abs();
+                let (u, v) = (3.0 * t, 0.7 * t);
+                P3::new(r * u.cos() * v.sin() + 0.0123, r * u.sin() * v.sin() - 0.0071, r * v.cos() + 0.0047)
+            })
+            .collect();
+        let order: Vec<usize> = (0..pts.len()).collect();
+        let d = idx.distances_in_order(&pts, &order);
+        let all = idx.query_all(&pts);
+        for (i, p) in pts.iter().enumerate() {
+            let q = idx.query(p);
+            assert_eq!(d[i], q.distance, "distance {i}");
+            assert_eq!((all[i].distance, all[i].face, all[i].point), (q.distance, q.face, q.point), "query {i}");
         }
     }
 

@@ -19,6 +19,8 @@ struct Checked {
     fallback: Option<String>,
     /// Whether the global maps onto the base domain replaced the per-patch ones.
     global_used: bool,
+    /// Why they did not, when they were tried.
+    global_fallback: Option<String>,
 }
 
 fn check(method: Method, s: &Mesh, t: &Mesh, gt: &[u32], k: usize) -> Checked {
@@ -85,6 +87,7 @@ fn check_with(
         reembedded: rep.smoothing.reembedded,
         fallback: rep.layout.fallback,
         global_used: rep.global.as_ref().is_some_and(|g| g.used),
+        global_fallback: rep.global.as_ref().and_then(|g| g.fallback.clone()),
     }
 }
 
@@ -158,6 +161,21 @@ fn smpl_16_anchors_needs_the_global_untangler() {
     let id: Vec<u32> = (0..s.n_vertices() as u32).collect();
     let v = check(Method::Voronoi, &s, &t, &id, 16);
     assert!(v.reembedded >= 1, "no region was re-embedded");
+}
+
+/// SMPL man -> woman with 12 anchors: the global composition folds 784 faces against the
+/// per-patch one's 17 and deviates in area by 1.54 against 0.11, so it is not relaxed at all
+/// (that relaxation cost 45 s in the bench sweep and lost); the per-patch maps are finished
+/// flip-free. Their area ratio (0.93) is below the 0.97, as reported in the notes.
+#[test]
+fn smpl_12_anchors_skips_a_global_composition_worse_on_every_count() {
+    let s = load("registered/smpl_human/human_man.obj");
+    let t = load("registered/smpl_human/human_woman.obj");
+    let id: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let v = check_with(Method::Voronoi, &s, &t, &id, 12, MapOptions::default(), 0.92..=1.04);
+    assert!(!v.global_used);
+    assert_eq!(v.global_fallback.as_deref(), Some("the per-patch composition is better on every count"));
+    assert!(v.gt_mean <= 0.03, "gt {}", v.gt_mean);
 }
 
 /// Genus 2 (skull) with 24 anchors: the Voronoi completion finds no split of a crowded region

@@ -74,6 +74,17 @@ impl SmoothReport {
     }
 }
 
+/// `J = [c0 c1]` of a mapped triangle, with `n0 = |c0|²`, `n1 = |c1|²`, `d = c0·c1` and
+/// `det = n0 n1 − d²` (positive).
+struct Jacobian {
+    c0: V3,
+    c1: V3,
+    n0: f64,
+    n1: f64,
+    d: f64,
+    det: f64,
+}
+
 /// A source triangle in its own orthonormal frame: `S^-1 = [[a, b], [0, c]]` (the inverse of
 /// the upper-triangular matrix of its edges) and its area.
 #[derive(Debug, Clone, Copy)]
@@ -111,17 +122,21 @@ impl SourceFrame {
     /// `scale`), times the source area: `|J|² + |J⁻¹|²` with `J = [m1 - m0, m2 - m0] S⁻¹`
     /// (3x2), so `|J⁻¹|² = |J|² / det(JᵀJ)`. `None` for a degenerate mapped triangle.
     pub(crate) fn energy(&self, m: [P3; 3], scale: f64) -> Option<f64> {
+        let j = self.jacobian(m, scale)?;
+        let fro = j.n0 + j.n1;
+        Some(self.area * (fro + fro / j.det))
+    }
+
+    /// The columns `c0`, `c1` of `J` for the mapped triangle `m` (scaled by `scale`), their
+    /// squared norms, dot product and `det(JᵀJ)`; `None` when that is not positive.
+    fn jacobian(&self, m: [P3; 3], scale: f64) -> Option<Jacobian> {
         let [a, b, c] = self.inv;
         let (e1, e2) = ((m[1] - m[0]) * scale, (m[2] - m[0]) * scale);
         let c0 = e1 * a;
         let c1 = e1 * b + e2 * c;
         let (n0, n1, d) = (c0.norm_squared(), c1.norm_squared(), c0.dot(&c1));
-        let fro = n0 + n1;
-        let det2 = n0 * n1 - d * d;
-        if det2 <= 0.0 || !det2.is_finite() {
-            return None;
-        }
-        Some(self.area * (fro + fro / det2))
+        let det = n0 * n1 - d * d;
+        (det > 0.0 && det.is_finite()).then_some(Jacobian { c0, c1, n0, n1, d, det })
     }
 
     /// Gradient and Hessian of [`SourceFrame::energy`] with respect to corner `corner` of `m`
@@ -138,16 +153,9 @@ impl SourceFrame {
         t1: V3,
         t2: V3,
     ) -> Option<([f64; 2], [[f64; 2]; 2])> {
+        let Jacobian { c0, c1, n0, n1, d, det: dd } = self.jacobian(m, scale)?;
         let [a, b, c] = self.inv;
-        let (e1, e2) = ((m[1] - m[0]) * scale, (m[2] - m[0]) * scale);
-        let c0 = e1 * a;
-        let c1 = e1 * b + e2 * c;
-        let (n0, n1, d) = (c0.norm_squared(), c1.norm_squared(), c0.dot(&c1));
         let f = n0 + n1;
-        let dd = n0 * n1 - d * d;
-        if dd <= 0.0 || !dd.is_finite() {
-            return None;
-        }
         let (al, be) = match corner {
             0 => (-scale * a, -scale * (b + c)),
             1 => (scale * a, scale * b),

@@ -12,6 +12,7 @@ pub mod compose;
 pub mod foldover_free;
 pub mod global;
 pub mod locate2d;
+pub mod newton;
 pub mod patch_param;
 pub mod planar_untangle;
 pub mod slide;

@@ -53,6 +53,8 @@ pub struct SmoothReport {
     /// Regions around remaining folds re-embedded through a target chart (`untangle`).
     pub reembedded: usize,
     pub untangled: usize,
+    /// Global projected-Newton steps taken after the sweeps ([`super::newton`], opt-in).
+    pub newton_steps: usize,
     pub moves: usize,
     pub rejected: usize,
     pub energy_before: f64,
@@ -66,6 +68,7 @@ impl SmoothReport {
             repaired: self.repaired + o.repaired,
             reembedded: self.reembedded + o.reembedded,
             untangled: self.untangled + o.untangled,
+            newton_steps: self.newton_steps + o.newton_steps,
             moves: self.moves + o.moves,
             rejected: self.rejected + o.rejected,
             energy_before: self.energy_before + o.energy_before,

@@ -15,7 +15,7 @@ pub const METHODS: [&str; 4] = ["voronoi", "greedy", "homology", "quad"];
 /// A parsed job spec.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Job {
-    Map(JobSpec),
+    Map(Box<JobSpec>),
     Remesh(RemeshSpec),
 }
 
@@ -40,7 +40,7 @@ impl Job {
             Some(m) if !METHODS.contains(&m) => {
                 Err(InputError::Spec(format!("unknown method {m:?}; available: {}", METHODS.join(", "))).into())
             }
-            _ => Ok(Job::Map(JobSpec::from_json(bytes)?)),
+            _ => Ok(Job::Map(Box::new(JobSpec::from_json(bytes)?))),
         }
     }
 

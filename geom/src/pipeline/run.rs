@@ -125,6 +125,7 @@ fn relax_with(
     progress: &mut dyn Progress,
 ) -> Result<(SurfaceMap, smooth::SmoothReport)> {
     let (mut m, r) = smooth::smooth(from, to, map, fixed, so, progress)?;
+    let newton = crate::crossparam::newton::relax_newton(from, to, &mut m, fixed, &o.newton, progress)?;
     let mut v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed, true)?;
     let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed, false)?;
     let untangled = crate::crossparam::untangle::untangle(from, to, &mut m, fixed, &o.untangle)?;
@@ -142,7 +143,17 @@ fn relax_with(
             v += crate::crossparam::visible::make_visible(from, to, &mut m, fixed, false)?;
         }
     }
-    Ok((m, smooth::SmoothReport { repaired, made_visible: v, reembedded: untangled.regions, ..r }))
+    Ok((
+        m,
+        smooth::SmoothReport {
+            repaired,
+            made_visible: v,
+            reembedded: untangled.regions,
+            newton_steps: newton.steps,
+            energy_after: if newton.steps > 0 { newton.energy_after } else { r.energy_after },
+            ..r
+        },
+    ))
 }
 
 /// One direction's metrics (the evaluator's definitions) of a relaxed map, and the source

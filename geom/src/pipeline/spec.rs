@@ -45,6 +45,8 @@ pub struct MapOptions {
     pub global: crate::crossparam::global::GlobalParamOptions,
     /// Stretch-reducing relocation of vertices across patch boundaries.
     pub smoothing: SmoothOptions,
+    /// Global projected-Newton relaxation after the smoothing sweeps (moves whole regions).
+    pub newton: crate::crossparam::newton::NewtonOptions,
     /// Re-embedding of regions around folds that the one-vertex repairs leave.
     pub untangle: crate::crossparam::untangle::UntangleOptions,
     /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
@@ -79,6 +81,7 @@ impl Default for MapOptions {
             param: PatchParamOptions::default(),
             global: Default::default(),
             smoothing: SmoothOptions::default(),
+            newton: Default::default(),
             untangle: Default::default(),
             metric_samples: 100_000,
             basis: [0, 0],
@@ -235,6 +238,7 @@ impl JobSpec {
                 InputError::Spec(format!("options.smoothing.area_weight must be finite and >= 0, got {w}")).into()
             );
         }
+        self.options.newton.check().map_err(InputError::Spec)?;
         if self.features.len() > MAX_FEATURES {
             return Err(InputError::Features(format!(
                 "{} feature curves exceed the limit {MAX_FEATURES}",
@@ -316,5 +320,30 @@ mod tests {
         let e = spec.validate(&m, &m).unwrap_err();
         assert_eq!(e.code(), "invalid_spec", "{e}");
         assert!(e.to_string().contains("area_weight"), "{e}");
+    }
+
+    #[test]
+    fn newton_options_out_of_range_are_spec_errors() {
+        let m = shapes::icosphere(1);
+        let spec = JobSpec {
+            method: Method::Voronoi,
+            anchors: vec![[0, 0], [3, 3], [7, 7]],
+            features: Vec::new(),
+            options: MapOptions::default(),
+        };
+        type Set = fn(&mut crate::crossparam::newton::NewtonOptions);
+        let cases: [(&str, Set); 4] = [
+            ("tolerance", |o| o.tolerance = f64::NAN),
+            ("max_move", |o| o.max_move = 0.0),
+            ("max_density", |o| o.max_density = -1.0),
+            ("min_cos", |o| o.min_cos = 2.0),
+        ];
+        for (name, set) in cases {
+            let mut bad = spec.clone();
+            set(&mut bad.options.newton);
+            let e = bad.validate(&m, &m).unwrap_err();
+            assert_eq!(e.code(), "invalid_spec", "{e}");
+            assert!(e.to_string().contains(name), "{name}: {e}");
+        }
     }
 }

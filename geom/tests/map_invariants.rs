@@ -12,6 +12,10 @@ use geom::topology::Locator;
 
 struct Checked {
     l2: f64,
+    /// L2 stretch of the map back (target to source).
+    l2_back: f64,
+    /// One-vertex flip repairs (both directions).
+    repaired: usize,
     gt_mean: f64,
     /// Regions re-embedded by the untangling stage (both directions).
     reembedded: usize,
@@ -83,6 +87,8 @@ fn check_with(
             / t.area().sqrt();
     Checked {
         l2: rep.source_to_target.l2_stretch,
+        l2_back: rep.target_to_source.l2_stretch,
+        repaired: rep.smoothing.repaired,
         gt_mean,
         reembedded: rep.smoothing.reembedded,
         fallback: rep.layout.fallback,
@@ -176,6 +182,20 @@ fn smpl_12_anchors_skips_a_global_composition_worse_on_every_count() {
     assert!(!v.global_used);
     assert_eq!(v.global_fallback.as_deref(), Some("the per-patch composition is better on every count"));
     assert!(v.gt_mean <= 0.03, "gt {}", v.gt_mean);
+}
+
+/// Sumner's cat in two poses (the registered pair, ground truth i <-> i), 24 anchors: the
+/// fold repairs leave distorted regions behind them, which one more relaxation after the
+/// repairs smooths out (L2 1.082 -> 1.068 both ways in the sweep, flip-free).
+#[test]
+fn cat_poses_relax_again_after_fold_repairs() {
+    let s = load("registered/sumner_cat_lion/cat-reference.obj");
+    let t = load("registered/sumner_cat_lion/cat-01.obj");
+    let id: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let v = check_with(Method::Voronoi, &s, &t, &id, 24, MapOptions::default(), 0.9..=1.04);
+    eprintln!("cat-01: L2 {} / {}, repaired {}, reembedded {}", v.l2, v.l2_back, v.repaired, v.reembedded);
+    assert!(v.repaired + v.reembedded > 0, "no repairs: the case no longer tests the relaxation after them");
+    assert!(v.l2 <= 1.072 && v.l2_back <= 1.072, "L2 {} / {}", v.l2, v.l2_back);
 }
 
 /// Genus 2 (skull) with 24 anchors: the Voronoi completion finds no split of a crowded region

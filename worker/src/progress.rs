@@ -16,6 +16,8 @@ const STAGES: &[(&str, f64, f64)] = &[
     ("parameterize", 0.40, 0.15),
     ("compose", 0.55, 0.05),
     ("smooth", 0.60, 0.20),
+    // The opt-in global Newton steps after the sweeps.
+    ("newton", 0.78, 0.02),
     ("remesh", 0.60, 0.10),
     ("images", 0.70, 0.10),
     ("metrics", 0.80, 0.18),

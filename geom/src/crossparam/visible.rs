@@ -140,6 +140,29 @@ pub(crate) fn evaluator_folded(
         && nm.dot(&tn[index.query(&crate::metrics::face_centroid(m)).face.idx()]) < 0.0
 }
 
+/// Faces of `map: source -> target` that the evaluator counts as flipped (screened by
+/// [`fold_suspects`], then confirmed by [`evaluator_folded`] with nearest faces).
+///
+/// # Errors
+/// `Error::Internal` if the target's index cannot be built.
+pub fn evaluator_flip_count(source: &Mesh, target: &Mesh, map: &SurfaceMap) -> crate::Result<usize> {
+    let pos: Vec<P3> = (0..source.n_vertices()).map(|v| map.position(VertexId::from_idx(v), target)).collect();
+    let tn = unit_normals(target);
+    let suspects = fold_suspects(source, map, &pos, &tn);
+    if suspects.is_empty() {
+        return Ok(0);
+    }
+    let index = SurfaceIndex::new(target)?;
+    Ok(suspects
+        .iter()
+        .filter(|&&f| {
+            let tri = source.face(f);
+            let m = tri.map(|w| pos[w.idx()]);
+            evaluator_folded(m, tri.map(|w| index.query(&pos[w.idx()]).face), &tn, &index)
+        })
+        .count())
+}
+
 /// Unit face normals of `mesh`.
 pub(crate) fn unit_normals(mesh: &Mesh) -> Vec<crate::mesh::V3> {
     (0..mesh.n_faces())

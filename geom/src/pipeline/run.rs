@@ -143,6 +143,18 @@ fn relax_with(
             v += crate::crossparam::visible::make_visible(from, to, &mut m, fixed, false)?;
         }
     }
+    // Repairs and re-embedded regions leave distortion behind them that the sweeps before
+    // could not see: the map is relaxed once more and kept if it is lower in energy and the
+    // evaluator counts no more flipped faces.
+    let mut energy_after = if newton.steps > 0 { newton.energy_after } else { r.energy_after };
+    if repaired > 0 || untangled.regions > 0 {
+        let (again, more) = relax_after_repairs(from, to, &m, fixed, so, progress)?;
+        if let Some((again, energy)) = again {
+            m = again;
+            repaired += more;
+            energy_after = energy;
+        }
+    }
     Ok((
         m,
         smooth::SmoothReport {
@@ -150,10 +162,34 @@ fn relax_with(
             made_visible: v,
             reembedded: untangled.regions,
             newton_steps: newton.steps,
-            energy_after: if newton.steps > 0 { newton.energy_after } else { r.energy_after },
+            energy_after,
             ..r
         },
     ))
+}
+
+/// One more relaxation of `map` after repairs: smoothing sweeps, hidden points revealed and
+/// one-vertex flip repairs (and hidden points again after them). `Some((map, energy))` when
+/// that lowers the energy without more faces the evaluator counts as flipped; with the number
+/// of repair moves it took.
+fn relax_after_repairs(
+    from: &Mesh,
+    to: &Mesh,
+    map: &SurfaceMap,
+    fixed: &[VertexId],
+    so: &smooth::SmoothOptions,
+    progress: &mut dyn Progress,
+) -> Result<(Option<(SurfaceMap, f64)>, usize)> {
+    let (mut again, _) = smooth::smooth(from, to, map.clone(), fixed, so, progress)?;
+    crate::crossparam::visible::make_visible(from, to, &mut again, fixed, false)?;
+    let moves = crate::crossparam::visible::repair_flips(from, to, &mut again, fixed, false)?;
+    if moves > 0 {
+        crate::crossparam::visible::make_visible(from, to, &mut again, fixed, false)?;
+    }
+    let flips = |m: &SurfaceMap| crate::crossparam::visible::evaluator_flip_count(from, to, m);
+    let energy = smooth::map_quality(from, to, &again).energy;
+    let better = energy < smooth::map_quality(from, to, map).energy && flips(&again)? <= flips(map)?;
+    Ok((better.then_some((again, energy)), moves))
 }
 
 /// One direction's metrics (the evaluator's definitions) of a relaxed map, and the source

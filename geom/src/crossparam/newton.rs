@@ -97,14 +97,7 @@ pub(crate) fn face_derivatives(
     t: &[[V3; 2]; 3],
 ) -> Option<([f64; 6], SMatrix<f64, 6, 6>)> {
     let [[a, b], [_, c]] = fr.inverse();
-    let (e1, e2) = ((m[1] - m[0]) * scale, (m[2] - m[0]) * scale);
-    let c0 = e1 * a;
-    let c1 = e1 * b + e2 * c;
-    let (n0, n1, d) = (c0.norm_squared(), c1.norm_squared(), c0.dot(&c1));
-    let dd = n0 * n1 - d * d;
-    if !(dd > 0.0 && dd.is_finite()) {
-        return None;
-    }
+    let super::smooth::Jacobian { c0, c1, n0, n1, d, det: dd } = fr.jacobian(m, scale)?;
     let al = [-scale * a, scale * a, 0.0];
     let be = [-scale * (b + c), scale * b, scale * c];
     let tv = |i: usize| t[i / 2][i % 2];
@@ -151,7 +144,7 @@ fn clamp_psd(h: SMatrix<f64, 6, 6>) -> SMatrix<f64, 6, 6> {
 }
 
 /// An orthonormal pair spanning the plane normal to `n` (not zero).
-fn tangents(n: V3) -> [V3; 2] {
+pub(crate) fn tangents(n: V3) -> [V3; 2] {
     let n = n.normalize();
     let t1 = if n.x.abs() < 0.9 { V3::x().cross(&n) } else { V3::y().cross(&n) }.normalize();
     [t1, n.cross(&t1)]

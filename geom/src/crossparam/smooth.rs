@@ -79,13 +79,13 @@ impl SmoothReport {
 
 /// `J = [c0 c1]` of a mapped triangle, with `n0 = |c0|²`, `n1 = |c1|²`, `d = c0·c1` and
 /// `det = n0 n1 − d²` (positive).
-struct Jacobian {
-    c0: V3,
-    c1: V3,
-    n0: f64,
-    n1: f64,
-    d: f64,
-    det: f64,
+pub(crate) struct Jacobian {
+    pub(crate) c0: V3,
+    pub(crate) c1: V3,
+    pub(crate) n0: f64,
+    pub(crate) n1: f64,
+    pub(crate) d: f64,
+    pub(crate) det: f64,
 }
 
 /// A source triangle in its own orthonormal frame: `S^-1 = [[a, b], [0, c]]` (the inverse of
@@ -132,7 +132,7 @@ impl SourceFrame {
 
     /// The columns `c0`, `c1` of `J` for the mapped triangle `m` (scaled by `scale`), their
     /// squared norms, dot product and `det(JᵀJ)`; `None` when that is not positive.
-    fn jacobian(&self, m: [P3; 3], scale: f64) -> Option<Jacobian> {
+    pub(crate) fn jacobian(&self, m: [P3; 3], scale: f64) -> Option<Jacobian> {
         let [a, b, c] = self.inv;
         let (e1, e2) = ((m[1] - m[0]) * scale, (m[2] - m[0]) * scale);
         let c0 = e1 * a;
@@ -329,9 +329,7 @@ pub fn smooth(
         if nl <= 0.0 {
             return None;
         }
-        let n = normal / nl;
-        let t1 = if n.x.abs() < 0.9 { V3::x().cross(&n) } else { V3::y().cross(&n) }.normalize();
-        let t2 = n.cross(&t1);
+        let [t1, t2] = super::newton::tangents(normal);
         let (mut reach, mut k) = (0.0, 0.0);
         for w in source.vertex_neighbors(v) {
             reach += (pos[w.idx()] - p).norm();

@@ -93,6 +93,18 @@ pub(crate) fn centroid(p: [P3; 3]) -> P3 {
     P3::new((p[0].x + p[1].x + p[2].x) / 3.0, (p[0].y + p[1].y + p[2].y) / 3.0, (p[0].z + p[1].z + p[2].z) / 3.0)
 }
 
+/// The `k`-th smallest of `d2` (its largest when it holds no more than `k`), selected in
+/// `buf`.
+fn kth_of(d2: &[f64], k: usize, buf: &mut Vec<f64>) -> f64 {
+    if d2.len() > k {
+        buf.clear();
+        buf.extend_from_slice(d2);
+        *buf.select_nth_unstable_by(k - 1, f64::total_cmp).1
+    } else {
+        d2.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
 impl<'m> SurfaceIndex<'m> {
     /// Builds the k-d tree of face centroids.
     ///
@@ -160,15 +172,15 @@ impl<'m> SurfaceIndex<'m> {
     /// Runs the candidate search for `pts` in their order (nearby points in turn), handing each
     /// answer to `put` with the point's index.
     ///
-    /// Queries are taken in blocks of nearby points. The block's first point `p0` gets a k-d
-    /// tree search (bounded by the previous point's k-th candidate distance plus the step
-    /// between the points: by the triangle inequality at least k centroids lie inside, so the
-    /// candidate set is that of an unbounded search). Its k-th distance `dk` admits into the
-    /// block the following points within `dk / 2` of `p0` (at most [`BLOCK`]); one radius search
-    /// then gathers every centroid within `dk + 2ρ` of `p0`, ρ the block's reach. A block point
-    /// `q` has its k nearest within `dk(q) ≤ dk + |q − p0|` of itself, so within `dk + 2ρ` of
-    /// `p0`: its k nearest of that gathered set (at most about 4k centroids on a surface) are its
-    /// k nearest overall, and the tree is searched once per block instead of once per point.
+    /// Queries are taken in blocks of nearby points. The block's first point `p0` has its k-th
+    /// nearest centroid within `h`, the previous point's k-th distance plus the step between
+    /// the points (triangle inequality). `h` admits into the block the following points within
+    /// `h / 2` of `p0` (at most [`BLOCK`]); one radius search then gathers every centroid within
+    /// `h + 2ρ` of `p0`, ρ the block's reach. A block point `q` has its k nearest within
+    /// `dk(q) ≤ h + |q − p0|` of itself, so within `h + 2ρ` of `p0`: its k nearest of that
+    /// gathered set (a few k centroids on a surface) are its k nearest overall. The tree is
+    /// searched once per block, and with a k-nearest search only where no previous point gives
+    /// `h` (a run's first point); the block's last point's k-th distance is the next `h`'s start.
     fn search_in_order(&self, pts: &[P3], sorted: bool, mut put: impl FnMut(usize, Nearest)) {
         let mut scratch = self.tree.create_scratch::<SquaredEuclidean<f64>>();
         let mut hint: Option<(P3, f64)> = None;
@@ -179,57 +191,42 @@ impl<'m> SurfaceIndex<'m> {
         let k = self.k.get();
         let mut start = 0;
         while start < pts.len() {
-            let i = start;
-            let p0 = pts[i];
+            let p0 = pts[start];
             let q = [p0.x, p0.y, p0.z];
-            let bounded = hint.and_then(|(prev, dk)| {
-                let r = (dk + (p0 - prev).norm()) * (1.0 + 1e-9);
-                let query = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k).within(r * r);
-                let c = if sorted {
+            // An upper bound on p0's k-th centroid distance: the previous point's plus the step
+            // between them, or (no previous point) a k-d tree search that answers p0 itself.
+            // A far step (a jump of the visiting order) would make that bound loose and the
+            // radius search large: such a point takes the k-d tree search.
+            let near_hint = hint.map(|(prev, dk)| (dk, (p0 - prev).norm())).filter(|&(dk, step)| step <= 0.5 * dk);
+            let Some(bound) = near_hint.map(|(dk, step)| (dk + step) * (1.0 + 1e-9)) else {
+                let query = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k);
+                let first = if sorted {
                     query.with_scratch(&mut scratch).execute()
                 } else {
                     query.unsorted().with_scratch(&mut scratch).execute()
                 };
-                // Always k by the triangle inequality; the fallback only guards degenerate input.
-                (c.len() == k).then_some(c)
-            });
-            let first = match bounded {
-                Some(c) => c,
-                None => {
-                    let query = self.tree.query(&q).nearest_n::<SquaredEuclidean<f64>>(self.k);
-                    if sorted {
-                        query.with_scratch(&mut scratch).execute()
-                    } else {
-                        query.unsorted().with_scratch(&mut scratch).execute()
-                    }
-                }
-            };
-            put(i, self.best_of(&p0, first.iter().map(|n| (n.item, n.distance))));
-            let dk = first.iter().map(|n| n.distance).fold(f64::NEG_INFINITY, f64::max).sqrt();
-            start += 1;
-            if !dk.is_finite() {
-                hint = None;
+                put(start, self.best_of(&p0, first.iter().map(|n| (n.item, n.distance))));
+                let dk = first.iter().map(|n| n.distance).fold(f64::NEG_INFINITY, f64::max).sqrt();
+                hint = dk.is_finite().then_some((p0, dk));
+                start += 1;
                 continue;
-            }
-            hint = Some((p0, dk));
-            // The block: following points within dk / 2 of p0.
-            let mut end = start;
+            };
+            // The block: p0 and the following points within bound / 2 of it.
+            let mut end = start + 1;
             let mut reach: f64 = 0.0;
             while end < pts.len() && end - start < BLOCK {
                 let d = (pts[end] - p0).norm();
-                if d > 0.5 * dk {
+                if d > 0.5 * bound {
                     break;
                 }
                 reach = reach.max(d);
                 end += 1;
             }
-            if end == start {
-                continue;
-            }
-            let r = (dk + 2.0 * reach) * (1.0 + 1e-9);
+            let r = (bound + 2.0 * reach) * (1.0 + 1e-9);
             let ball = self.tree.query(&q).within::<SquaredEuclidean<f64>>(r * r).unsorted().execute();
             if ball.len() < k {
-                // Never by the triangle inequality; degenerate input takes one search per point.
+                // Never by the triangle inequality; degenerate input takes a k-d tree search.
+                hint = None;
                 continue;
             }
             gathered.clear();
@@ -240,34 +237,74 @@ impl<'m> SurfaceIndex<'m> {
                     let (dx, dy, dz) = (c[0] - p.x, c[1] - p.y, c[2] - p.z);
                     dx * dx + dy * dy + dz * dz
                 }));
-                // The k-th smallest squared distance: the candidates are those not beyond it
-                // (every centroid tied at exactly that distance is admitted).
-                let kth = if d2.len() > k {
-                    kth_buf.clear();
-                    kth_buf.extend_from_slice(&d2);
-                    *kth_buf.select_nth_unstable_by(k - 1, f64::total_cmp).1
-                } else {
-                    d2.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-                };
                 let best = if sorted {
+                    // The k-th smallest squared distance: the candidates are those not beyond it
+                    // (every centroid tied at exactly that distance is admitted).
+                    let kth = kth_of(&d2, k, &mut kth_buf);
                     cand.clear();
                     cand.extend(d2.iter().zip(&gathered).filter(|(d, _)| **d <= kth).map(|(d, g)| (*d, g.1)));
                     cand.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
                     cand.truncate(k);
                     self.best_of(&p, cand.iter().map(|&(d, item)| (item, d)))
                 } else {
-                    // The nearest centroid first: its distance prunes most of the others.
-                    let near = (0..d2.len()).min_by(|&a, &b| d2[a].total_cmp(&d2[b])).unwrap_or(0);
-                    let rest = (0..d2.len()).filter(|&c| c != near && d2[c] <= kth);
-                    self.best_of(&p, std::iter::once(near).chain(rest).map(|c| (gathered[c].1, d2[c])))
+                    self.nearest_distance_among(&p, &gathered, &d2, k, &mut cand, &mut kth_buf)
                 };
                 put(j, best);
-                if d2.len() >= k {
-                    hint = Some((p, kth.sqrt()));
+                if j + 1 == end && d2.len() >= k {
+                    hint = Some((p, kth_of(&d2, k, &mut kth_buf).sqrt()));
                 }
             }
             start = end;
         }
+    }
+
+    /// The distance of [`SurfaceIndex::query`] for `p` (its face and point may be another
+    /// candidate's on a tie), given `gathered`, a superset of its `k` nearest centroids, with
+    /// their squared distances `d2`.
+    ///
+    /// The nearest centroid's face is tested first. Only the gathered faces whose lower bound
+    /// (centroid distance minus radius) does not exceed that distance can be closer; when no
+    /// more than `k - 1` centroids are strictly nearer than the farthest of them, all of them
+    /// are among the `k` nearest, and the k-th distance (a selection over the gathered set) is
+    /// not needed. Otherwise they are filtered by it. Either way the minimum is taken over the
+    /// same candidates as the evaluator's.
+    fn nearest_distance_among(
+        &self,
+        p: &P3,
+        gathered: &[([f64; 3], u32)],
+        d2: &[f64],
+        k: usize,
+        maybe: &mut Vec<(f64, u32)>,
+        kth_buf: &mut Vec<f64>,
+    ) -> Nearest {
+        let mut near = 0;
+        for (c, d) in d2.iter().enumerate() {
+            if *d < d2[near] {
+                near = c;
+            }
+        }
+        let best = self.best_of(p, std::iter::once((gathered[near].1, d2[near])));
+        // Faces that may be closer: sqrt(d2)(1 - 1e-9) - r <= best, tested on squares with
+        // more slack (a face that cannot be strictly closer may pass, none that can is lost).
+        maybe.clear();
+        let mut far: f64 = 0.0;
+        for (c, (&d, g)) in d2.iter().zip(gathered).enumerate() {
+            let reach = best.distance + self.radius[g.1 as usize];
+            if c != near && d * (1.0 - 4e-9) <= reach * reach {
+                maybe.push((d, g.1));
+                far = far.max(d);
+            }
+        }
+        if maybe.is_empty() {
+            return best;
+        }
+        let nearer = d2.iter().filter(|&&d| d < far).count();
+        if nearer >= k {
+            let kth = kth_of(d2, k, kth_buf);
+            maybe.retain(|&(d, _)| d <= kth);
+        }
+        let rest = self.best_of(p, maybe.iter().map(|&(d, item)| (item, d)));
+        if rest.distance < best.distance { rest } else { best }
     }
 
     /// Nearest point among the candidate faces.

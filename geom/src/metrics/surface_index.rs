@@ -180,7 +180,8 @@ impl<'m> SurfaceIndex<'m> {
     /// `dk(q) ≤ h + |q − p0|` of itself, so within `h + 2ρ` of `p0`: its k nearest of that
     /// gathered set (a few k centroids on a surface) are its k nearest overall. The tree is
     /// searched once per block, and with a k-nearest search only where no previous point gives
-    /// `h` (a run's first point); the block's last point's k-th distance is the next `h`'s start.
+    /// `h` (a run's first point, or a step longer than half the previous k-th distance, which
+    /// would make `h` loose); the block's last point's k-th distance is the next `h`'s start.
     fn search_in_order(&self, pts: &[P3], sorted: bool, mut put: impl FnMut(usize, Nearest)) {
         let mut scratch = self.tree.create_scratch::<SquaredEuclidean<f64>>();
         let mut hint: Option<(P3, f64)> = None;

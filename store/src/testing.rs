@@ -30,3 +30,26 @@ pub async fn fresh_postgres_database(base: &str) -> Result<String> {
     };
     Ok(format!("{host_part}/{name}{query}"))
 }
+
+/// Whether a writer could take the SQLite write lock at this instant (`BEGIN IMMEDIATE` with no
+/// busy wait, rolled back at once). A process stopped with `SIGSTOP` in the middle of a commit
+/// keeps that lock until it is continued, so a test that stalls a worker checks this first.
+///
+/// # Errors
+/// When the file cannot be opened.
+pub async fn sqlite_write_lock_free(url: &str) -> Result<bool> {
+    use sqlx::sqlite::SqliteConnectOptions;
+    use sqlx::{ConnectOptions, Connection};
+    use std::str::FromStr;
+    let mut conn = SqliteConnectOptions::from_str(url)?.busy_timeout(std::time::Duration::ZERO).connect().await?;
+    let free = match sqlx::raw_sql("BEGIN IMMEDIATE").execute(&mut conn).await {
+        Ok(_) => {
+            sqlx::raw_sql("ROLLBACK").execute(&mut conn).await?;
+            true
+        }
+        Err(sqlx::Error::Database(e)) if e.message().contains("locked") || e.message().contains("busy") => false,
+        Err(e) => return Err(e.into()),
+    };
+    conn.close().await?;
+    Ok(free)
+}

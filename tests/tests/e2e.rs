@@ -280,9 +280,17 @@ async fn a_stalled_worker_s_late_write_is_rejected_by_the_fence() {
         async move { (api.job(&id).await["state"] == "running").then_some(()) }
     });
     assert!(started.await.is_some());
-    a.signal("STOP");
-    let _b = env.worker("b", &["--lease-secs", "2"]);
-    let done = api.wait_done(&id, Duration::from_secs(120)).await;
+    stop_outside_a_commit(&a, &env).await;
+    let b = env.worker("b", &["--lease-secs", "2"]);
+    let done = wait_for(Duration::from_secs(120), || {
+        let (api, id) = (api.clone(), id.clone());
+        async move {
+            let j = api.job(&id).await;
+            matches!(j["state"].as_str(), Some("succeeded" | "failed" | "cancelled")).then_some(j)
+        }
+    })
+    .await
+    .unwrap_or_else(|| panic!("job {id} did not finish; worker b:\n{}\nworker a:\n{}", b.log_text(), a.log_text()));
     assert_eq!(
         (done["state"].as_str(), done["attempts"].as_i64(), done["worker"].as_str()),
         (Some("succeeded"), Some(2), Some("b"))
@@ -297,6 +305,22 @@ async fn a_stalled_worker_s_late_write_is_rejected_by_the_fence() {
     assert_eq!(after, done, "the late worker changed nothing");
     a.signal("TERM");
     assert!(a.wait_exit(Duration::from_secs(30)).is_some_and(|s| s.success()));
+}
+
+/// Stops `p` at an instant it does not hold the SQLite write lock. A process stopped in the
+/// middle of a commit (a heartbeat) keeps that lock until it is continued, and every other
+/// writer waits on it; that is SQLite's locking, not the fence this test is about.
+async fn stop_outside_a_commit(p: &common::Proc, env: &Env) {
+    for _ in 0..100 {
+        p.signal("STOP");
+        if surfmap_store::testing::sqlite_write_lock_free(&env.database_url).await.expect("open the database") {
+            return;
+        }
+        eprintln!("the worker was stopped inside a commit; continuing it and stopping it again");
+        p.signal("CONT");
+        tokio::time::sleep(Duration::from_millis(37)).await;
+    }
+    panic!("the worker held the write lock at every one of 100 tries");
 }
 
 async fn restart(env: &Env) {

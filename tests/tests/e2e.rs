@@ -282,15 +282,10 @@ async fn a_stalled_worker_s_late_write_is_rejected_by_the_fence() {
     assert!(started.await.is_some());
     stop_outside_a_commit(&a, &env).await;
     let b = env.worker("b", &["--lease-secs", "2"]);
-    let done = wait_for(Duration::from_secs(120), || {
-        let (api, id) = (api.clone(), id.clone());
-        async move {
-            let j = api.job(&id).await;
-            matches!(j["state"].as_str(), Some("succeeded" | "failed" | "cancelled")).then_some(j)
-        }
-    })
-    .await
-    .unwrap_or_else(|| panic!("job {id} did not finish; worker b:\n{}\nworker a:\n{}", b.log_text(), a.log_text()));
+    let done = api
+        .poll_done(&id, Duration::from_secs(120))
+        .await
+        .unwrap_or_else(|| panic!("job {id} did not finish; worker b:\n{}\nworker a:\n{}", b.log_text(), a.log_text()));
     assert_eq!(
         (done["state"].as_str(), done["attempts"].as_i64(), done["worker"].as_str()),
         (Some("succeeded"), Some(2), Some("b"))

@@ -296,8 +296,8 @@ impl Api {
     pub async fn job(&self, id: &str) -> Value {
         self.get(&format!("/v1/jobs/{id}")).await.1
     }
-    /// Waits for a terminal state.
-    pub async fn wait_done(&self, id: &str, timeout: Duration) -> Value {
+    /// Waits for a terminal state; `None` after `timeout`.
+    pub async fn poll_done(&self, id: &str, timeout: Duration) -> Option<Value> {
         let api = self.clone();
         let id = id.to_string();
         wait_for(timeout, || {
@@ -308,7 +308,10 @@ impl Api {
             }
         })
         .await
-        .unwrap_or_else(|| panic!("job {id} did not finish within {timeout:?}"))
+    }
+    /// Waits for a terminal state.
+    pub async fn wait_done(&self, id: &str, timeout: Duration) -> Value {
+        self.poll_done(id, timeout).await.unwrap_or_else(|| panic!("job {id} did not finish within {timeout:?}"))
     }
     pub async fn bytes(&self, path: &str) -> (u16, Vec<u8>, String) {
         let r = self.req(reqwest::Method::GET, path).send().await.expect("get");

@@ -4,6 +4,11 @@
 //! (interior, then edge regions AB, AC, BC, then vertex regions A, B, C), keeping the first
 //! strictly closer candidate. A distance is exact, or slightly too large when the true closest
 //! face is not among the candidates: exactly the evaluator's definition.
+//!
+//! Batches of queries are answered in Morton order from radius searches shared by runs of
+//! nearby points: small balls a few faces wide that prove each answer without the k nearest
+//! ([`small_ball`]), or, where faces vary too much in size, balls that hold every point's k
+//! nearest (`search_in_order`).
 
 use crate::error::{Error, Result};
 use crate::mesh::{FaceId, Mesh, P3, V3};
@@ -29,7 +34,12 @@ pub struct SurfaceIndex<'m> {
     radius: Vec<f64>,
     /// Face centroids, as in the tree.
     centroids: Vec<[f64; 3]>,
+    /// The face-size tiers of distance-only searches ([`small_ball`]), unless too many faces
+    /// are large for them to pay.
+    tiers: Option<small_ball::Tiers>,
 }
+
+mod small_ball;
 
 /// One query's answer.
 #[derive(Debug, Clone, Copy)]
@@ -125,7 +135,8 @@ impl<'m> SurfaceIndex<'m> {
         let tree = ImmutableKdTree::new_from_slice(&cents).map_err(|e| Error::Internal(format!("k-d tree: {e:?}")))?;
         let k = NonZeroUsize::new(CANDIDATES.min(mesh.n_faces()))
             .ok_or_else(|| Error::Internal("mesh has no faces".into()))?;
-        Ok(Self { mesh, tree, k, radius, centroids: cents })
+        let tiers = small_ball::Tiers::new(&cents, &radius)?;
+        Ok(Self { mesh, tree, k, radius, centroids: cents, tiers })
     }
 
     /// The distances of [`SurfaceIndex::query`] for `pts`, visited in `order` (nearby points in
@@ -163,7 +174,10 @@ impl<'m> SurfaceIndex<'m> {
                 let mut out = Vec::with_capacity(run.len());
                 // The run's points copied in visiting order: the searches read them in sequence.
                 let local: Vec<P3> = run.iter().map(|&i| pts[i]).collect();
-                self.search_in_order(&local, sorted, |k, n| out.push((run[k], n)));
+                match &self.tiers {
+                    Some(t) => self.search_small_ball(t, &local, sorted, |k, n| out.push((run[k], n))),
+                    _ => self.search_in_order(&local, sorted, |k, n| out.push((run[k], n))),
+                }
                 out
             })
             .collect()
@@ -395,6 +409,48 @@ mod tests {
             let q = idx.query(p);
             assert_eq!(d[i], q.distance, "distance {i}");
             assert_eq!((all[i].distance, all[i].face, all[i].point), (q.distance, q.face, q.point), "query {i}");
+        }
+    }
+
+    #[test]
+    fn answers_among_faces_of_mixed_sizes_equal_plain_queries() {
+        // A bumpy 40 x 40 grid whose last column of cells is stretched twelvefold: 80 large
+        // faces, so the small-ball search takes its two tiers, and points near the seam see
+        // large faces just outside their balls.
+        let g = shapes::grid(40);
+        let pos: Vec<P3> = g
+            .positions()
+            .iter()
+            .map(|p| {
+                let x = if p.x > 0.975 + 1e-12 { 0.975 + (p.x - 0.975) * 12.0 } else { p.x };
+                P3::new(x, p.y, 0.03 * (7.0 * x).sin() * (5.0 * p.y).cos())
+            })
+            .collect();
+        let m = g.with_positions(pos).unwrap();
+        let idx = SurfaceIndex::new(&m).unwrap();
+        let t = idx.tiers.as_ref().expect("tiers");
+        assert!(t.has_large());
+        let pts: Vec<P3> = (0..8000)
+            .map(|i| {
+                let t = f64::from(i) * 0.0011;
+                let x = 0.5 + 0.8 * (t * 3.1).sin();
+                let y = 0.5 + 0.55 * (t * 1.7).cos();
+                P3::new(x + 0.0013, y - 0.0007, 0.04 * (t * 11.0).sin() + 0.001)
+            })
+            .collect();
+        let order: Vec<usize> = (0..pts.len()).collect();
+        let d = idx.distances_in_order(&pts, &order);
+        let all = idx.query_all(&pts);
+        for (i, p) in pts.iter().enumerate() {
+            let q = idx.query(p);
+            assert_eq!(d[i], q.distance, "distance {i}");
+            assert_eq!((all[i].distance, all[i].face, all[i].point), (q.distance, q.face, q.point), "query {i}");
+        }
+        // Mapped vertices on the surface, ties between faces included.
+        let on = idx.query_all(m.positions());
+        for (i, p) in m.positions().iter().enumerate() {
+            let q = idx.query(p);
+            assert_eq!((on[i].distance, on[i].face), (q.distance, q.face), "vertex {i}");
         }
     }
 

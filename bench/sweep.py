@@ -6,6 +6,7 @@ Usage: python3 bench/sweep.py BINARY [METHOD] [FILTER]   (needs numpy + scipy)
 """
 import json
 import os
+import subprocess
 import sys
 import tempfile
 
@@ -53,6 +54,19 @@ def cases(tmp):
     yield "lion/cat 55", lambda: (f"{cat}/lion-reference.obj", f"{cat}/cat-reference.obj", [[b, a] for a, b in mk], None)
 
 
+def gt_map_l2(tmp, s, t, gt):
+    """L2 stretch of the ground-truth map itself (source vertex i at target vertex gt[i]): how far
+    from isometric the case's deformation is. A low-distortion map cannot follow a ground truth
+    whose own L2 stretch is high, so its ground-truth error there measures the case."""
+    VS, FS = mm.load_mesh(s)
+    VT, _ = mm.load_mesh(t)
+    p = os.path.join(tmp, "gt_map.off")
+    t2.write_off(p, VT[np.loadtxt(gt, dtype=np.int64)].astype(float), FS)
+    out = subprocess.run([sys.executable, os.path.join(os.path.dirname(M), "eval", "meshmetrics.py"), s, t, p,
+                          "--samples", "1000"], capture_output=True, text=True, check=True).stdout
+    return json.loads(out)["l2_stretch"]
+
+
 def main():
     binary = sys.argv[1]
     method = sys.argv[2] if len(sys.argv) > 2 else "voronoi"
@@ -69,16 +83,21 @@ def main():
                 bad.append(name)
                 continue
             gtm = e.get("gt_error_mean", float("nan"))
+            same_shape = gt is not None and any(k in name for k in ["bend", "twist", "shuffle", "subdivided"])
+            gt_l2 = gt_map_l2(tmp, s, t, gt) if same_shape else float("nan")
             fb = e["report"].get("layout", {}).get("fallback")
             g = e["report"].get("global")
             if g and not g["used"]:
                 fb = f"{fb or ''} per-patch: {g.get('fallback')}"
             name = f"{name} [{fb}]" if fb else name
             line = (f"{name:32s} {e['time']:6.2f}s flips {e['flipped_faces']}/{e['rev_flips']} area {e['area_ratio']:.4f} "
-                    f"L2 {e['l2_stretch']:.4f} gt {gtm:.4f} anchor {e['anchor_error_max']:.1e} off {e['off_surface_max']:.1e}"
+                    f"L2 {e['l2_stretch']:.4f} gt {gtm:.4f} (gt map L2 {gt_l2:.3f}) anchor {e['anchor_error_max']:.1e} off {e['off_surface_max']:.1e}"
                     + (f" E0 {e['report']['smoothing']['energy_before']:.3f} G {e['report'].get('global')}" if os.environ.get("SWEEP_ENERGY") else ""))
             miss = e["flipped_faces"] or e["rev_flips"] or not 0.97 <= e["area_ratio"] <= 1.03 or \
                 e["anchor_error_max"] > 1e-9 or e["off_surface_max"] > 1e-6
+            # Same-shape cases (24 anchors): the ground-truth error and L2 bounds as well.
+            if same_shape:
+                miss = miss or gtm > 0.02 or e["l2_stretch"] > 1.15
             if miss:
                 bad.append(name)
             print(line + ("   <-- MISS" if miss else ""), flush=True)

@@ -103,6 +103,23 @@ pub(crate) fn centroid(p: [P3; 3]) -> P3 {
     P3::new((p[0].x + p[1].x + p[2].x) / 3.0, (p[0].y + p[1].y + p[2].y) / 3.0, (p[0].z + p[1].z + p[2].z) / 3.0)
 }
 
+/// The block of queries starting at `pts[start]`: it and the points right after it within
+/// `within` of it, at most [`BLOCK`]. Returns the end (exclusive) and the largest distance.
+fn block(pts: &[P3], start: usize, within: f64) -> (usize, f64) {
+    let p0 = pts[start];
+    let mut end = start + 1;
+    let mut reach: f64 = 0.0;
+    while end < pts.len() && end - start < BLOCK {
+        let d = (pts[end] - p0).norm();
+        if d > within {
+            break;
+        }
+        reach = reach.max(d);
+        end += 1;
+    }
+    (end, reach)
+}
+
 /// The `k`-th smallest of `d2` (its largest when it holds no more than `k`), selected in
 /// `buf`.
 fn kth_of(d2: &[f64], k: usize, buf: &mut Vec<f64>) -> f64 {
@@ -227,16 +244,7 @@ impl<'m> SurfaceIndex<'m> {
                 continue;
             };
             // The block: p0 and the following points within bound / 2 of it.
-            let mut end = start + 1;
-            let mut reach: f64 = 0.0;
-            while end < pts.len() && end - start < BLOCK {
-                let d = (pts[end] - p0).norm();
-                if d > 0.5 * bound {
-                    break;
-                }
-                reach = reach.max(d);
-                end += 1;
-            }
+            let (end, reach) = block(pts, start, 0.5 * bound);
             let r = (bound + 2.0 * reach) * (1.0 + 1e-9);
             let ball = self.tree.query(&q).within::<SquaredEuclidean<f64>>(r * r).unsorted().execute();
             if ball.len() < k {
@@ -386,6 +394,19 @@ mod tests {
         }
     }
 
+    /// The batch searches (distances in the given order, and whole answers) give exactly what
+    /// one plain query per point gives.
+    fn batches_equal_plain_queries(idx: &SurfaceIndex, pts: &[P3]) {
+        let order: Vec<usize> = (0..pts.len()).collect();
+        let d = idx.distances_in_order(pts, &order);
+        let all = idx.query_all(pts);
+        for (i, p) in pts.iter().enumerate() {
+            let q = idx.query(p);
+            assert_eq!(d[i], q.distance, "distance {i}");
+            assert_eq!((all[i].distance, all[i].face, all[i].point), (q.distance, q.face, q.point), "query {i}");
+        }
+    }
+
     #[test]
     fn block_answers_equal_plain_queries() {
         // A slow walk inside and outside the sphere: consecutive points are close, so most are
@@ -402,14 +423,7 @@ mod tests {
                 P3::new(r * u.cos() * v.sin() + 0.0123, r * u.sin() * v.sin() - 0.0071, r * v.cos() + 0.0047)
             })
             .collect();
-        let order: Vec<usize> = (0..pts.len()).collect();
-        let d = idx.distances_in_order(&pts, &order);
-        let all = idx.query_all(&pts);
-        for (i, p) in pts.iter().enumerate() {
-            let q = idx.query(p);
-            assert_eq!(d[i], q.distance, "distance {i}");
-            assert_eq!((all[i].distance, all[i].face, all[i].point), (q.distance, q.face, q.point), "query {i}");
-        }
+        batches_equal_plain_queries(&idx, &pts);
     }
 
     #[test]
@@ -438,14 +452,7 @@ mod tests {
                 P3::new(x + 0.0013, y - 0.0007, 0.04 * (t * 11.0).sin() + 0.001)
             })
             .collect();
-        let order: Vec<usize> = (0..pts.len()).collect();
-        let d = idx.distances_in_order(&pts, &order);
-        let all = idx.query_all(&pts);
-        for (i, p) in pts.iter().enumerate() {
-            let q = idx.query(p);
-            assert_eq!(d[i], q.distance, "distance {i}");
-            assert_eq!((all[i].distance, all[i].face, all[i].point), (q.distance, q.face, q.point), "query {i}");
-        }
+        batches_equal_plain_queries(&idx, &pts);
         // Mapped vertices on the surface, ties between faces included.
         let on = idx.query_all(m.positions());
         for (i, p) in m.positions().iter().enumerate() {

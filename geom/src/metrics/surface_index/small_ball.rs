@@ -19,7 +19,7 @@
 //! the ball is a few faces wide instead of twice the k nearest's reach, and its radius follows
 //! the previous block's need. A point whose checks fail takes the k-nearest search.
 
-use super::{BLOCK, Nearest, SurfaceIndex};
+use super::{Nearest, SurfaceIndex};
 use crate::error::{Error, Result};
 use crate::mesh::P3;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -131,16 +131,7 @@ impl SurfaceIndex<'_> {
         while start < pts.len() {
             let p0 = pts[start];
             let q0 = [p0.x, p0.y, p0.z];
-            let mut end = start + 1;
-            let mut reach: f64 = 0.0;
-            while end < pts.len() && end - start < BLOCK {
-                let d = (pts[end] - p0).norm();
-                if d > 0.5 * base {
-                    break;
-                }
-                reach = reach.max(d);
-                end += 1;
-            }
+            let (end, reach) = super::block(pts, start, 0.5 * base);
             let r = base + reach;
             ball.clear();
             for n in self.tree.query(&q0).within::<SquaredEuclidean<f64>>(r * r).unsorted().execute() {

@@ -120,6 +120,42 @@ fn block(pts: &[P3], start: usize, within: f64) -> (usize, f64) {
     (end, reach)
 }
 
+/// Index of the smallest of `d2` (the first on a tie); `d2` must not be empty.
+fn argmin(d2: &[f64]) -> usize {
+    let mut near = 0;
+    for (c, d) in d2.iter().enumerate() {
+        if *d < d2[near] {
+            near = c;
+        }
+    }
+    near
+}
+
+/// The faces that may be closer to a point than `best`, the distance to the face of its
+/// nearest centroid `near`: those whose centroid distance minus radius does not exceed it,
+/// tested on squares with more slack (a face that cannot be strictly closer may pass, none that
+/// can is lost). `d2` are the squared centroid distances, `radius(c)` and `id(c)` the radius and
+/// face of centroid `c`. Fills `maybe` with `(d2, face)` and returns the largest such `d2`.
+fn contenders_of(
+    d2: &[f64],
+    near: usize,
+    best: f64,
+    radius: impl Fn(usize) -> f64,
+    id: impl Fn(usize) -> u32,
+    maybe: &mut Vec<(f64, u32)>,
+) -> f64 {
+    maybe.clear();
+    let mut far: f64 = 0.0;
+    for (c, &d) in d2.iter().enumerate() {
+        let reach = best + radius(c);
+        if c != near && d * (1.0 - 4e-9) <= reach * reach {
+            maybe.push((d, id(c)));
+            far = far.max(d);
+        }
+    }
+    far
+}
+
 /// The `k`-th smallest of `d2` (its largest when it holds no more than `k`), selected in
 /// `buf`.
 fn kth_of(d2: &[f64], k: usize, buf: &mut Vec<f64>) -> f64 {
@@ -300,24 +336,10 @@ impl<'m> SurfaceIndex<'m> {
         maybe: &mut Vec<(f64, u32)>,
         kth_buf: &mut Vec<f64>,
     ) -> Nearest {
-        let mut near = 0;
-        for (c, d) in d2.iter().enumerate() {
-            if *d < d2[near] {
-                near = c;
-            }
-        }
+        let near = argmin(d2);
         let best = self.best_of(p, std::iter::once((gathered[near].1, d2[near])));
-        // Faces that may be closer: sqrt(d2)(1 - 1e-9) - r <= best, tested on squares with
-        // more slack (a face that cannot be strictly closer may pass, none that can is lost).
-        maybe.clear();
-        let mut far: f64 = 0.0;
-        for (c, (&d, g)) in d2.iter().zip(gathered).enumerate() {
-            let reach = best.distance + self.radius[g.1 as usize];
-            if c != near && d * (1.0 - 4e-9) <= reach * reach {
-                maybe.push((d, g.1));
-                far = far.max(d);
-            }
-        }
+        let radius = |c: usize| self.radius[gathered[c].1 as usize];
+        let far = contenders_of(d2, near, best.distance, radius, |c| gathered[c].1, maybe);
         if maybe.is_empty() {
             return best;
         }
@@ -340,9 +362,12 @@ impl<'m> SurfaceIndex<'m> {
         self.best_of(p, cand.iter().map(|n| (n.item, n.distance)))
     }
 
-    /// The first strictly closest of the candidates `(face, squared centroid distance)`.
+    /// The closest of the candidates `(face, squared centroid distance)`, and of equally close
+    /// ones the one with the nearest centroid: in ascending centroid order (the evaluator's),
+    /// the first strictly closest; in any order, the same face unless centroids tie too.
     fn best_of(&self, p: &P3, cand: impl Iterator<Item = (u32, f64)>) -> Nearest {
         let mut best = Nearest { distance: f64::INFINITY, face: FaceId(0), point: *p };
+        let mut best_d2 = f64::INFINITY;
         for (item, d2) in cand {
             let lower = d2.sqrt() * (1.0 - 1e-9) - self.radius[item as usize];
             if lower > best.distance {
@@ -352,8 +377,9 @@ impl<'m> SurfaceIndex<'m> {
             let [a, b, c] = self.mesh.face_points(f);
             let q = closest_point_on_triangle(*p, a, b, c);
             let d = (q - p).norm();
-            if d < best.distance {
+            if d < best.distance || (d == best.distance && d2 < best_d2) {
                 best = Nearest { distance: d, face: f, point: q };
+                best_d2 = d2;
             }
         }
         best

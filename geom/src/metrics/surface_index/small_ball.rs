@@ -183,12 +183,7 @@ impl SurfaceIndex<'_> {
             let (dx, dy, dz) = (g.x[i] - p.x, g.y[i] - p.y, g.z[i] - p.z);
             dx * dx + dy * dy + dz * dz
         }));
-        let mut near = 0;
-        for (c, d) in d2.iter().enumerate() {
-            if *d < d2[near] {
-                near = c;
-            }
-        }
+        let near = super::argmin(d2);
         let d_near = d2[near].sqrt();
         // (a) the nearest centroid is the ball's.
         if d_near >= avail {
@@ -205,15 +200,7 @@ impl SurfaceIndex<'_> {
                 return None;
             }
         }
-        maybe.clear();
-        let mut far: f64 = 0.0;
-        for (c, &d) in d2.iter().enumerate() {
-            let reach = best.distance + g.radius[c];
-            if c != near && d * (1.0 - 4e-9) <= reach * reach {
-                maybe.push((d, g.id[c]));
-                far = far.max(d);
-            }
-        }
+        let far = super::contenders_of(d2, near, best.distance, |c| g.radius[c], |c| g.id[c], maybe);
         let far_r = far.sqrt();
         // (c) every centroid nearer than the farthest contender is the ball's, and fewer than k
         // of them are.
@@ -225,33 +212,12 @@ impl SurfaceIndex<'_> {
             return Some((best, need));
         }
         if sorted {
+            // The rule's face on ties: of the closest, the nearest centroid's (`best_of`).
             maybe.push((d2[near], g.id[near]));
-            return Some((self.first_in_order(p, maybe), need));
+            return Some((self.best_of(p, maybe.iter().map(|&(d, item)| (item, d))), need));
         }
         let rest = self.best_of(p, maybe.iter().map(|&(d, item)| (item, d)));
         Some((if rest.distance < best.distance { rest } else { best }, need))
-    }
-
-    /// Of the candidates `(squared centroid distance, face)`, in any order, the closest face
-    /// that comes first in centroid-distance order: what [`SurfaceIndex::best_of`] returns
-    /// for them sorted.
-    fn first_in_order(&self, p: &P3, cand: &[(f64, u32)]) -> Nearest {
-        let mut best = Nearest { distance: f64::INFINITY, face: crate::mesh::FaceId(0), point: *p };
-        let mut best_d2 = f64::INFINITY;
-        for &(d2, item) in cand {
-            if d2.sqrt() * (1.0 - 1e-9) - self.radius[item as usize] > best.distance {
-                continue;
-            }
-            let f = crate::mesh::FaceId(item);
-            let [a, b, c] = self.mesh.face_points(f);
-            let q = super::closest_point_on_triangle(*p, a, b, c);
-            let d = (q - p).norm();
-            if d < best.distance || (d == best.distance && d2 < best_d2) {
-                best = Nearest { distance: d, face: f, point: q };
-                best_d2 = d2;
-            }
-        }
-        best
     }
 
     /// The k-nearest search's answer for `p`, and a radius around `p` that holds its k

@@ -87,6 +87,14 @@ pub enum InputError {
     Spec(String),
     #[error("no consistent patch layout: {0}")]
     LayoutConflict(String),
+    /// An option's value lies outside its documented range (the message names both).
+    #[error("option out of range: {0}")]
+    OptionRange(String),
+    /// The job's estimated peak memory exceeds the budget a service runs jobs with.
+    #[error(
+        "the job needs an estimated {estimate_mib} MiB, above the budget of {budget_mib} MiB per job: use smaller meshes or options"
+    )]
+    OverBudget { estimate_mib: u64, budget_mib: u64 },
 }
 
 impl InputError {
@@ -115,6 +123,8 @@ impl InputError {
             InputError::Features(_) => "invalid_features",
             InputError::Spec(_) => "invalid_spec",
             InputError::LayoutConflict(_) => "layout_conflict",
+            InputError::OptionRange(_) => "option_out_of_range",
+            InputError::OverBudget { .. } => "over_budget",
         }
     }
 }

@@ -9,6 +9,8 @@ use sha2::{Digest, Sha256};
 #[derive(Debug, Clone, Default)]
 pub struct Auth {
     owners: Vec<(Vec<u8>, String)>,
+    /// Hash of the operators' token for `/metrics`, if one is configured.
+    metrics: Option<Vec<u8>>,
 }
 
 impl Auth {
@@ -21,7 +23,28 @@ impl Auth {
                 (h.to_vec(), hex::encode(&h[..12]))
             })
             .collect();
-        Auth { owners }
+        Auth { owners, metrics: None }
+    }
+
+    /// Requires `token` for `/metrics` (`--metrics-token`); empty or `None` leaves it unset.
+    pub fn with_metrics_token(mut self, token: Option<&str>) -> Auth {
+        self.metrics = token.filter(|t| !t.is_empty()).map(|t| Sha256::digest(t.as_bytes()).to_vec());
+        self
+    }
+
+    /// May this request read `/metrics`? With a metrics token, only with that token; else,
+    /// when API tokens are configured, never (the figures span every tenant); else always.
+    ///
+    /// # Errors
+    /// 401 when the request may not.
+    pub fn metrics_allowed(&self, authorization: Option<&str>) -> Result<(), ApiError> {
+        let presented = authorization.and_then(|h| h.strip_prefix("Bearer ")).map(str::trim);
+        match (&self.metrics, presented) {
+            (Some(k), Some(t)) if k[..] == Sha256::digest(t.as_bytes())[..] => Ok(()),
+            (Some(_), _) => Err(ApiError::unauthorized()),
+            (None, _) if self.enabled() => Err(ApiError::unauthorized()),
+            (None, _) => Ok(()),
+        }
     }
 
     pub fn enabled(&self) -> bool {
@@ -56,5 +79,18 @@ mod tests {
         assert!(!x.is_empty() && x != y);
         assert_eq!(a.owner(Some("Bearer gamma")).unwrap_err().code, "unauthorized");
         assert_eq!(a.owner(None).unwrap_err().code, "unauthorized");
+    }
+
+    #[test]
+    fn metrics_need_the_metrics_token_when_tokens_are_configured() {
+        assert!(Auth::new(&[]).metrics_allowed(None).is_ok());
+        let tenants = Auth::new(&["alpha".into()]);
+        assert!(tenants.metrics_allowed(Some("Bearer alpha")).is_err(), "a tenant sees no global figures");
+        let ops = Auth::new(&["alpha".into()]).with_metrics_token(Some("ops"));
+        assert!(ops.metrics_allowed(Some("Bearer ops")).is_ok());
+        assert!(ops.metrics_allowed(Some("Bearer alpha")).is_err());
+        assert!(ops.metrics_allowed(None).is_err());
+        let open = Auth::new(&[]).with_metrics_token(Some("ops"));
+        assert!(open.metrics_allowed(None).is_err() && open.metrics_allowed(Some("Bearer ops")).is_ok());
     }
 }

@@ -30,12 +30,16 @@ pub fn app(state: AppState) -> axum::Router {
     let (reporter, health) = tonic_health::server::health_reporter();
     tokio::spawn(async move { reporter.set_serving::<SurfmapServer<grpc::GrpcApi>>().await });
     let mut routes = tonic::service::Routes::new(grpc).add_service(health);
-    match tonic_reflection::server::Builder::configure()
-        .register_encoded_file_descriptor_set(surfmap_proto::FILE_DESCRIPTOR_SET)
-        .build_v1()
-    {
-        Ok(r) => routes = routes.add_service(r),
-        Err(e) => tracing::warn!("gRPC reflection unavailable: {e}"),
+    // Reflection in both versions clients speak (grpcurl and most tools: v1; older ones:
+    // v1alpha), describing this API and `grpc.health.v1`.
+    let reflection = || {
+        tonic_reflection::server::Builder::configure()
+            .register_encoded_file_descriptor_set(surfmap_proto::FILE_DESCRIPTOR_SET)
+            .register_encoded_file_descriptor_set(tonic_health::pb::FILE_DESCRIPTOR_SET)
+    };
+    match (reflection().build_v1(), reflection().build_v1alpha()) {
+        (Ok(v1), Ok(v1alpha)) => routes = routes.add_service(v1).add_service(v1alpha),
+        (Err(e), _) | (_, Err(e)) => tracing::warn!("gRPC reflection unavailable: {e}"),
     }
     // tonic's router brings a fallback (gRPC `unimplemented`); replace it with the JSON 404
     // so the merged router has exactly one.

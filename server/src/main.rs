@@ -27,9 +27,16 @@ struct Args {
     /// Bearer token a client must present (repeatable). With tokens, clients see only their own jobs.
     #[arg(long = "api-token", env = "SURFMAP_API_TOKENS", value_delimiter = ',')]
     api_tokens: Vec<String>,
+    /// Bearer token that `/metrics` requires. With API tokens and none of this, `/metrics`
+    /// is closed (its figures span every tenant).
+    #[arg(long, env = "SURFMAP_METRICS_TOKEN")]
+    metrics_token: Option<String>,
     /// Largest request body in MiB.
     #[arg(long, env = "SURFMAP_MAX_BODY_MB", default_value_t = 256)]
     max_body_mb: usize,
+    /// Largest JSON request body (a job's spec with its anchors and features) in MiB.
+    #[arg(long, env = "SURFMAP_MAX_JSON_MB", default_value_t = 8)]
+    max_json_mb: usize,
     /// Largest mesh in vertices.
     #[arg(long, env = "SURFMAP_MAX_VERTICES", default_value_t = 2_000_000)]
     max_vertices: u64,
@@ -45,11 +52,25 @@ struct Args {
     /// On SIGTERM, how long running jobs may finish before their leases are released.
     #[arg(long, env = "SURFMAP_SHUTDOWN_GRACE_SECS", default_value_t = 60)]
     shutdown_grace_secs: u64,
+    /// Memory budget of one job in MiB: jobs estimated above it are refused, and each job's
+    /// process is capped at it (an allocation beyond it fails the job, not the service).
+    #[arg(long, env = "SURFMAP_JOB_MEMORY_MB", default_value_t = 8192)]
+    job_memory_mb: u64,
 }
 
-#[tokio::main]
-async fn main() -> std::process::ExitCode {
-    surfmap_worker::process_main("surfmap-server", run(Args::parse())).await
+fn main() -> std::process::ExitCode {
+    // A job's child process (`surfmap-server __run-job DIR`) runs the job and exits.
+    if let Some(code) = surfmap_worker::main_if_child() {
+        return code;
+    }
+    let args = Args::parse();
+    match tokio::runtime::Builder::new_multi_thread().enable_all().build() {
+        Ok(rt) => rt.block_on(surfmap_worker::process_main("surfmap-server", run(args))),
+        Err(e) => {
+            eprintln!("surfmap-server: cannot start the runtime: {e}");
+            std::process::ExitCode::from(1)
+        }
+    }
 }
 
 async fn run(a: Args) -> anyhow::Result<()> {
@@ -61,12 +82,15 @@ async fn run(a: Args) -> anyhow::Result<()> {
     let blobs = surfmap_store::BlobStore::open(&a.data_dir)?;
     let limits = Limits {
         max_body_bytes: a.max_body_mb.saturating_mul(1 << 20),
+        max_json_bytes: a.max_json_mb.saturating_mul(1 << 20),
         max_vertices: a.max_vertices,
         max_attempts: a.max_attempts,
+        job_memory_bytes: a.job_memory_mb.saturating_mul(1 << 20),
         ..Limits::default()
     };
     let service = JobService { store: store.clone(), blobs: blobs.clone(), limits };
-    let state = AppState { service, auth: Auth::new(&a.api_tokens) };
+    let auth = Auth::new(&a.api_tokens).with_metrics_token(a.metrics_token.as_deref());
+    let state = AppState { service, auth };
     let listener = tokio::net::TcpListener::bind(&a.listen).await?;
     let addr = listener.local_addr()?;
     println!("listening on {addr}");
@@ -82,6 +106,7 @@ async fn run(a: Args) -> anyhow::Result<()> {
         rx.clone(),
     )));
     let n = a.workers.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let runner = surfmap_worker::Runner::current_exe()?;
     for i in 0..n {
         let config = WorkerConfig {
             id: format!("{}-w{i}", WorkerConfig::default_id()),
@@ -89,6 +114,8 @@ async fn run(a: Args) -> anyhow::Result<()> {
             time_limit: Duration::from_secs(a.time_limit_secs),
             max_vertices: a.max_vertices,
             shutdown_grace: Duration::from_secs(a.shutdown_grace_secs),
+            runner: runner.clone(),
+            job_memory_bytes: a.job_memory_mb.saturating_mul(1 << 20),
             ..WorkerConfig::default()
         };
         let w = Worker { store: store.clone(), blobs: blobs.clone(), config };

@@ -15,21 +15,27 @@ use surfmap_store::{ArtifactRef, BlobStore, JobFilter, JobRecord, JobState, Mesh
 pub struct Limits {
     /// Largest request body (mesh uploads, multipart jobs), enforced while streaming.
     pub max_body_bytes: usize,
+    /// Largest JSON body (a job with its spec, anchors and features), checked before parsing.
+    pub max_json_bytes: usize,
     /// Largest mesh, in vertices (checked from headers before allocation).
     pub max_vertices: u64,
     /// Attempts a job gets before an expired lease fails it.
     pub max_attempts: i64,
     /// How often watchers (SSE, WatchJob) look at the job.
     pub watch_interval: Duration,
+    /// Memory budget of one job: a job whose estimate exceeds it is refused at submission.
+    pub job_memory_bytes: u64,
 }
 
 impl Default for Limits {
     fn default() -> Self {
         Self {
             max_body_bytes: 256 << 20,
+            max_json_bytes: 8 << 20,
             max_vertices: 2_000_000,
             max_attempts: 3,
             watch_interval: Duration::from_millis(200),
+            job_memory_bytes: surfmap_worker::DEFAULT_JOB_MEMORY_BYTES,
         }
     }
 }
@@ -176,6 +182,14 @@ impl JobService {
             summaries.push(self.summary(owner, &role, id).await?);
         }
         job.check(&summaries)?;
+        let estimate = job.memory_estimate(&summaries);
+        if estimate > self.limits.job_memory_bytes {
+            return Err(geom::Error::from(geom::InputError::OverBudget {
+                estimate_mib: estimate.div_ceil(1 << 20),
+                budget_mib: self.limits.job_memory_bytes >> 20,
+            })
+            .into());
+        }
         let method = job.method();
         let spec = match job {
             Job::Map(_) => job.to_json()?,

@@ -182,6 +182,19 @@ async fn openapi_and_probes() {
         assert!(doc["paths"][path].is_object(), "{path} missing from the OpenAPI document");
     }
     assert!(doc["components"]["schemas"]["JobView"].is_object());
+    // The document is valid OpenAPI: openapi-spec-validator reports no error (the README's
+    // test command installs it).
+    let file = t._dir.path().join("openapi.json");
+    std::fs::write(&file, doc.to_string()).unwrap();
+    let script = "import json, sys\nfrom openapi_spec_validator import validate\nfrom openapi_spec_validator.validation.exceptions import OpenAPIValidationError\n\
+        errors = 0\ntry:\n    validate(json.load(open(sys.argv[1])))\nexcept OpenAPIValidationError as e:\n    print(e); errors = 1\nsys.exit(errors)";
+    let out = std::process::Command::new("python3").arg("-c").arg(script).arg(&file).output().expect("python3");
+    assert!(
+        out.status.success(),
+        "openapi-spec-validator (python3 -m pip install openapi-spec-validator):\n{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert_eq!(json_call(&t, "GET", "/healthz", Body::empty()).await.0, StatusCode::OK);
     let (st, r) = json_call(&t, "GET", "/readyz", Body::empty()).await;
     assert_eq!((st, r["store"].as_str()), (StatusCode::OK, Some("sqlite")));
@@ -314,4 +327,66 @@ async fn quad_job_over_three_meshes_through_the_queue() {
         .unwrap();
     let (st, _, e) = call(&t, req).await;
     assert!(st.is_client_error(), "{st} {}", String::from_utf8_lossy(&e));
+}
+
+/// Options out of their range (the spec bombs that once took the server down), unknown fields
+/// at any depth and jobs over the memory budget are refused at submission, naming the field.
+#[tokio::test]
+async fn spec_bombs_nested_unknown_fields_and_budget_are_refused_at_submission() {
+    let mut t = setup().await;
+    t.state.service.limits.max_json_bytes = 64 << 10;
+    let (s, tg) = sphere_pair();
+    let (_, a) = json_call(&t, "POST", "/v1/meshes", Body::from(s)).await;
+    let (_, b) = json_call(&t, "POST", "/v1/meshes", Body::from(tg)).await;
+    let submit = |spec: Value| {
+        let body = json!({"source": a["id"], "target": b["id"], "spec": spec}).to_string();
+        Request::post("/v1/jobs").header("content-type", "application/json").body(Body::from(body)).unwrap()
+    };
+    let with = |options: Value| {
+        let mut s = spec();
+        s["options"] = options;
+        s
+    };
+    let cases = [
+        (
+            json!({"layout": {"edge_nodes": {"min_nodes": 1_000_000_000u64}}}),
+            422,
+            "option_out_of_range",
+            "layout.edge_nodes.min_nodes",
+        ),
+        (json!({"metric_samples": 1_000_000_000_000u64}), 422, "option_out_of_range", "metric_samples"),
+        (json!({"smoothing": {"iterations": 1u64 << 40}}), 422, "option_out_of_range", "smoothing.iterations"),
+        (json!({"untangle": {"max_rings": 100_000}}), 422, "option_out_of_range", "untangle.max_rings"),
+        (json!({"layout": {"bogus": 1}}), 400, "invalid_spec", "bogus"),
+        (json!({"smoothing": {"bogus": 1}}), 400, "invalid_spec", "bogus"),
+        (json!({"layout": {"flip": {"bogus": 1}}}), 400, "invalid_spec", "bogus"),
+        (json!({"global": {"bogus": 1}}), 400, "invalid_spec", "bogus"),
+    ];
+    for (options, status, code, field) in cases {
+        let (st, _, body) = call(&t, submit(with(options.clone()))).await;
+        let e: Value = serde_json::from_slice(&body).unwrap();
+        assert_eq!((st.as_u16(), e["code"].as_str()), (status, Some(code)), "{options}: {e}");
+        let msg = e["message"].as_str().unwrap();
+        assert!(msg.contains(field), "{options}: {msg}");
+        if status == 422 {
+            assert!(msg.contains("outside its range ["), "names the range: {msg}");
+        }
+    }
+    // A JSON body over its own limit (an anchor list of 100 kB): 413 before it is parsed.
+    let mut big = spec();
+    big["anchors"] = json!((0..10_000).map(|i| [i, i]).collect::<Vec<_>>());
+    let (st, _, body) = call(&t, submit(big)).await;
+    let e: Value = serde_json::from_slice(&body).unwrap();
+    assert_eq!((st.as_u16(), e["code"].as_str()), (413, Some("payload_too_large")), "{e}");
+    // A budget smaller than the job's estimate: 422 over_budget, before anything is queued.
+    let mut small = setup().await;
+    small.state.service.limits.job_memory_bytes = 1 << 20;
+    let (_, a2) = json_call(&small, "POST", "/v1/meshes", Body::from(sphere_pair().0)).await;
+    let body = json!({"source": a2["id"], "target": a2["id"], "spec": spec()}).to_string();
+    let req = Request::post("/v1/jobs").header("content-type", "application/json").body(Body::from(body)).unwrap();
+    let (st, _, body) = call(&small, req).await;
+    let e: Value = serde_json::from_slice(&body).unwrap();
+    assert_eq!((st.as_u16(), e["code"].as_str()), (422, Some("over_budget")), "{e}");
+    let (_, list) = json_call(&small, "GET", "/v1/jobs", Body::empty()).await;
+    assert_eq!(list["jobs"].as_array().map(Vec::len), Some(0), "{list}");
 }

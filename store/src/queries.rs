@@ -345,6 +345,20 @@ impl Store {
         Ok(n == 1)
     }
 
+    /// Gives a running job back to the queue counting the attempt (its process crashed; the
+    /// caller fails it instead once `attempts` reaches `max_attempts`).
+    ///
+    /// # Errors
+    /// Database failures.
+    pub async fn retry(&self, id: &str, fence: i64) -> Result<bool> {
+        let now = now_ms();
+        let n = on!(self, p => sqlx::query(
+            "UPDATE jobs SET state = 'queued', stage = 'retry', progress = 0, lease_owner = NULL, \
+             lease_expires_at = NULL, updated_at = $3 WHERE id = $1 AND fence = $2 AND state = 'running'")
+            .bind(id).bind(fence).bind(now).execute(p).await?.rows_affected());
+        Ok(n == 1)
+    }
+
     /// Requeues running jobs whose lease expired before now; fails those out of attempts and
     /// cancels those whose cancellation was asked for.
     ///

@@ -107,7 +107,7 @@ async fn rest_and_grpc(env: &Env) {
     {
         use tonic_reflection::pb::v1::server_reflection_request::MessageRequest;
         use tonic_reflection::pb::v1::server_reflection_response::MessageResponse;
-        let mut refl = tonic_reflection::pb::v1::server_reflection_client::ServerReflectionClient::new(channel);
+        let mut refl = tonic_reflection::pb::v1::server_reflection_client::ServerReflectionClient::new(channel.clone());
         let ask = tonic_reflection::pb::v1::ServerReflectionRequest {
             host: String::new(),
             message_request: Some(MessageRequest::ListServices(String::new())),
@@ -116,8 +116,25 @@ async fn rest_and_grpc(env: &Env) {
         match answers.next().await.unwrap().unwrap().message_response {
             Some(MessageResponse::ListServicesResponse(l)) => {
                 assert!(l.service.iter().any(|s| s.name == "surfmap.v1.Surfmap"), "{l:?}");
+                assert!(l.service.iter().any(|s| s.name == "grpc.health.v1.Health"), "{l:?}");
             }
             other => panic!("reflection answered {other:?}"),
+        }
+        // The older v1alpha protocol too, describing the health service's file.
+        use tonic_reflection::pb::v1alpha as alpha;
+        let mut refl = alpha::server_reflection_client::ServerReflectionClient::new(channel);
+        let ask = alpha::ServerReflectionRequest {
+            host: String::new(),
+            message_request: Some(alpha::server_reflection_request::MessageRequest::FileContainingSymbol(
+                "grpc.health.v1.Health".into(),
+            )),
+        };
+        let mut answers = refl.server_reflection_info(futures::stream::iter([ask])).await.unwrap().into_inner();
+        match answers.next().await.unwrap().unwrap().message_response {
+            Some(alpha::server_reflection_response::MessageResponse::FileDescriptorResponse(f)) => {
+                assert!(!f.file_descriptor_proto.is_empty());
+            }
+            other => panic!("v1alpha reflection answered {other:?}"),
         }
     }
     let data = std::fs::read(shared(SMPL.0)).unwrap();

@@ -4,11 +4,10 @@
 use crate::Shutdown;
 use crate::config::WorkerConfig;
 use crate::progress::Shared;
-use geom::io::ReadOptions;
-use geom::mesh::MeshLimits;
+use crate::running::{Finished, RunError, Running};
 use geom::pipeline::Job;
 use std::time::Instant;
-use surfmap_store::{ArtifactRef, BlobStore, Claim, Heartbeat, Outcome, Store, StoreError};
+use surfmap_store::{ArtifactRef, BlobStore, Claim, Heartbeat, JobRecord, Outcome, Store, StoreError};
 use tracing::{info, warn};
 
 /// What one [`Worker::run_once`] did.
@@ -76,62 +75,86 @@ impl Worker {
         let Claim { job, fence } = claim;
         let started = Instant::now();
         let lease_ms = i64::try_from(self.config.lease.as_millis()).unwrap_or(i64::MAX);
-        let inputs = match self.load(&job.spec, &job.source, &job.target).await {
-            Ok(x) => x,
-            Err(e) => return self.finish(&job.id, fence, &job.method, started, Err(e), &Stops::default()).await,
-        };
         let shared = Shared::default();
-        let mut progress = shared.clone();
-        let (spec, meshes) = inputs;
-        let mut handle = tokio::task::spawn_blocking(move || geom::pipeline::run_job(&spec, &meshes, &mut progress));
-        let deadline = tokio::time::Instant::now() + self.config.time_limit;
-        let mut grace_end: Option<tokio::time::Instant> = None;
+        let mut running = match self.load(&job.spec, &job.source, &job.target).await {
+            Ok((spec, meshes)) => Running::start(&self.config, spec, meshes, &shared).await,
+            Err(e) => Err(RunError::Geom(e)),
+        };
         let mut stops = Stops::default();
+        if let Ok(run) = &mut running {
+            self.supervise(run, &shared, &job.id, fence, lease_ms, &mut shutdown, &mut stops).await;
+        }
+        let stopped = stops.user || stops.lost || stops.timed_out || stops.shutdown;
+        let result = match running {
+            Ok(run) => match run.collect(stopped).await {
+                Ok(done) => self.store_artifacts(done).await,
+                Err(e) => Err(e),
+            },
+            Err(e) => Err(e),
+        };
+        self.finish(&job, fence, started, result, &stops).await
+    }
+
+    /// Heartbeats while the run lasts and stops it on cancel, time limit, lost lease or the
+    /// end of the shutdown grace, each within a heartbeat period (the deadlines exactly).
+    #[allow(clippy::too_many_arguments)]
+    async fn supervise(
+        &self,
+        run: &mut Running,
+        shared: &Shared,
+        id: &str,
+        fence: i64,
+        lease_ms: i64,
+        shutdown: &mut Shutdown,
+        stops: &mut Stops,
+    ) {
+        let deadline = tokio::time::Instant::now() + self.config.time_limit;
+        let far = deadline + std::time::Duration::from_secs(365 * 86_400);
+        let mut grace_end = far;
         let mut tick = tokio::time::interval(self.config.heartbeat());
         tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
-        let result = loop {
+        loop {
             tokio::select! {
-                r = &mut handle => break r,
+                _ = run.ended() => return,
                 _ = tick.tick() => {
                     let (stage, frac) = shared.snapshot();
                     let stage = if stage.is_empty() { "loading".to_string() } else { stage };
-                    match self.store.heartbeat(&job.id, fence, &stage, frac, lease_ms).await {
-                        Ok(Heartbeat::Extended { cancel }) if cancel && !stops.user => { stops.user = true; shared.cancel(); }
+                    match self.store.heartbeat(id, fence, &stage, frac, lease_ms).await {
+                        Ok(Heartbeat::Extended { cancel }) if cancel && !stops.user => {
+                            stops.user = true;
+                            run.stop(shared);
+                        }
                         Ok(Heartbeat::Lost) if !stops.lost => {
-                            warn!(job = %job.id, fence, "lease lost to another worker; stopping and discarding this run");
+                            warn!(job = %id, fence, "lease lost to another worker; stopping and discarding this run");
                             stops.lost = true;
-                            shared.cancel();
+                            run.stop(shared);
                         }
                         Ok(_) => {}
-                        Err(e) => warn!(job = %job.id, "heartbeat failed: {e}"),
+                        Err(e) => warn!(job = %id, "heartbeat failed: {e}"),
                     }
-                    let now = tokio::time::Instant::now();
-                    if now >= deadline && !stops.timed_out { stops.timed_out = true; shared.cancel(); }
-                    if grace_end.is_some_and(|g| now >= g) { shared.cancel(); }
                 }
-                _ = shutdown.changed(), if grace_end.is_none() => {
+                _ = tokio::time::sleep_until(deadline), if !stops.timed_out => {
+                    stops.timed_out = true;
+                    run.stop(shared);
+                }
+                _ = tokio::time::sleep_until(grace_end), if grace_end < far => {
+                    grace_end = far;
+                    run.stop(shared);
+                }
+                _ = shutdown.changed(), if !stops.shutdown => {
                     if *shutdown.borrow() {
-                        info!(job = %job.id, "shutdown: finishing the current job within the grace period");
+                        info!(job = %id, "shutdown: finishing the current job within the grace period");
                         stops.shutdown = true;
-                        grace_end = Some(tokio::time::Instant::now() + self.config.shutdown_grace);
+                        grace_end = tokio::time::Instant::now() + self.config.shutdown_grace;
                     }
                 }
             }
-        };
-        let result = match result {
-            Ok(r) => r,
-            Err(e) => Err(geom::Error::Internal(format!("pipeline thread panicked: {e}"))),
-        };
-        let result = match result {
-            Ok((report, artifacts)) => self.store_artifacts(report, artifacts).await,
-            Err(e) => Err(e),
-        };
-        self.finish(&job.id, fence, &job.method, started, result, &stops).await
+        }
     }
 
-    /// Spec and meshes of a job, read under the vertex cap. A pair job stores its spec and its
-    /// source and target; an N-mesh job stores `{"meshes": [id, ...], "spec": {...}}`.
-    async fn load(&self, spec: &str, source: &str, target: &str) -> Result<(Job, Vec<geom::Mesh>), geom::Error> {
+    /// Spec and mesh bytes of a job. A pair job stores its spec and its source and target; an
+    /// N-mesh job stores `{"meshes": [id, ...], "spec": {...}}`.
+    async fn load(&self, spec: &str, source: &str, target: &str) -> Result<(Job, Vec<Vec<u8>>), geom::Error> {
         let stored: serde_json::Value = serde_json::from_str(spec).unwrap_or_default();
         let ids = stored
             .get("meshes")
@@ -144,9 +167,7 @@ impl Worker {
             }
             _ => (Job::from_json(spec.as_bytes())?, vec![source.to_string(), target.to_string()]),
         };
-        let limits = MeshLimits { max_vertices: self.config.max_vertices, max_faces: 2 * self.config.max_vertices + 8 };
-        let read = move |bytes: Vec<u8>| geom::io::read(&bytes, &ReadOptions { limits, hint: None }).map(|r| r.mesh);
-        let mut pending = Vec::with_capacity(keys.len());
+        let mut meshes = Vec::with_capacity(keys.len());
         for key in &keys {
             let bytes = self
                 .blobs
@@ -154,48 +175,35 @@ impl Worker {
                 .await
                 .map_err(|e| geom::Error::Internal(format!("blob {key}: {e}")))?
                 .ok_or_else(|| geom::Error::Internal(format!("mesh blob {key} is missing from the data dir")))?;
-            pending.push(tokio::task::spawn_blocking(move || read(bytes)));
-        }
-        let mut meshes = Vec::with_capacity(pending.len());
-        for p in pending {
-            meshes.push(p.await.map_err(|e| geom::Error::Internal(e.to_string()))??);
+            meshes.push(bytes);
         }
         Ok((job, meshes))
     }
 
-    async fn store_artifacts(
-        &self,
-        report: geom::pipeline::JobOutput,
-        artifacts: Vec<geom::pipeline::Artifact>,
-    ) -> Result<(String, Vec<ArtifactRef>), geom::Error> {
-        let mut refs = Vec::with_capacity(artifacts.len());
-        for a in artifacts {
-            let sha256 =
-                self.blobs.put(&a.bytes).await.map_err(|e| geom::Error::Internal(format!("artifact store: {e}")))?;
-            refs.push(ArtifactRef {
-                name: a.name,
-                content_type: a.content_type.to_string(),
-                sha256,
-                size: a.bytes.len() as u64,
-            });
+    async fn store_artifacts(&self, done: Finished) -> Result<(String, Vec<ArtifactRef>), RunError> {
+        let internal = |m: String| RunError::Geom(geom::Error::Internal(m));
+        let mut refs = Vec::with_capacity(done.artifacts.len());
+        for (name, content_type, bytes) in done.artifacts {
+            let sha256 = self.blobs.put(&bytes).await.map_err(|e| internal(format!("artifact store: {e}")))?;
+            refs.push(ArtifactRef { name, content_type, sha256, size: bytes.len() as u64 });
         }
-        for (stage, ms) in &report.timings_ms {
-            metrics::histogram!("surfmap_stage_duration_seconds", "method" => report.method, "stage" => stage.clone())
+        for (stage, ms) in &done.timings_ms {
+            metrics::histogram!("surfmap_stage_duration_seconds", "method" => done.method.clone(), "stage" => stage.clone())
                 .record(ms / 1e3);
         }
-        let json = serde_json::to_string(&report.report).map_err(|e| geom::Error::Internal(e.to_string()))?;
+        let json = serde_json::to_string(&done.report).map_err(|e| internal(e.to_string()))?;
         Ok((json, refs))
     }
 
     async fn finish(
         &self,
-        id: &str,
+        job: &JobRecord,
         fence: i64,
-        method: &str,
         started: Instant,
-        result: Result<(String, Vec<ArtifactRef>), geom::Error>,
+        result: Result<(String, Vec<ArtifactRef>), RunError>,
         stops: &Stops,
     ) -> Result<String, StoreError> {
+        let id = job.id.as_str();
         if stops.lost {
             return Ok("lease_lost".into());
         }
@@ -203,20 +211,42 @@ impl Worker {
             // A cancellation asked for while the last stage finished still wins.
             _ if stops.user => Outcome::Cancelled,
             Ok((result, artifacts)) => Outcome::Succeeded { result, artifacts },
-            Err(geom::Error::Cancelled) if stops.timed_out => Outcome::Failed {
+            Err(_) if stops.timed_out => Outcome::Failed {
                 code: "time_limit".into(),
                 message: format!("the job ran longer than its limit of {} s", self.config.time_limit.as_secs()),
             },
-            Err(geom::Error::Cancelled) if stops.shutdown => {
+            Err(_) if stops.shutdown => {
                 let released = self.store.release(id, fence).await?;
                 info!(job = %id, released, "shutdown: lease released, the job goes back to the queue");
                 return Ok("released".into());
             }
-            Err(e) => {
+            Err(RunError::Crashed(why)) if job.attempts < job.max_attempts => {
+                warn!(job = %id, attempt = job.attempts, "{why}; the job goes back to the queue");
+                metrics::counter!("surfmap_job_crashes_total").increment(1);
+                let requeued = self.store.retry(id, fence).await?;
+                return Ok(if requeued { "retried" } else { "fence_rejected" }.into());
+            }
+            Err(RunError::Crashed(why)) => {
+                metrics::counter!("surfmap_job_crashes_total").increment(1);
+                Outcome::Failed {
+                    code: "worker_crashed".into(),
+                    message: format!("{why}, on each of {} attempts", job.attempts),
+                }
+            }
+            Err(RunError::Stopped) | Err(RunError::Geom(geom::Error::Cancelled)) => {
+                Outcome::Failed { code: "cancelled".into(), message: "the job was stopped".into() }
+            }
+            Err(RunError::Geom(e)) => {
                 if matches!(e, geom::Error::Internal(_)) {
                     tracing::error!(job = %id, "internal error: {e}");
                 }
                 Outcome::Failed { code: e.code().to_string(), message: e.to_string() }
+            }
+            Err(RunError::Failed { code, message, internal }) => {
+                if internal {
+                    tracing::error!(job = %id, "internal error: {message}");
+                }
+                Outcome::Failed { code, message }
             }
         };
         let state = match &outcome {
@@ -227,7 +257,7 @@ impl Worker {
             }
             Outcome::Cancelled => "cancelled",
         };
-        metrics::histogram!("surfmap_job_duration_seconds", "method" => method.to_string(), "outcome" => state)
+        metrics::histogram!("surfmap_job_duration_seconds", "method" => job.method.clone(), "outcome" => state)
             .record(started.elapsed().as_secs_f64());
         if self.store.complete(id, fence, &outcome).await? {
             info!(job = %id, state, secs = started.elapsed().as_secs_f64(), "completed");

@@ -1,13 +1,16 @@
-//! The worker: claim a job -> load its meshes -> run `geom::pipeline::run_map` on a blocking
-//! thread while heartbeating -> store artifacts -> complete, fenced. Owns the job execution
+//! The worker: claim a job -> load its meshes -> run `geom::pipeline::run_job` in a child
+//! process (or on a blocking thread) while heartbeating -> store artifacts -> complete, fenced. Owns the job execution
 //! rules (time limit, vertex cap, cancellation, graceful shutdown); the SQL is the store's.
 
+pub mod child;
 mod config;
 mod execute;
 mod progress;
+mod running;
 pub mod telemetry;
 
-pub use config::WorkerConfig;
+pub use child::main_if_child;
+pub use config::{DEFAULT_JOB_MEMORY_BYTES, Runner, WorkerConfig};
 pub use execute::{Ran, Worker};
 
 /// A shutdown signal: `true` once the process should stop taking work.

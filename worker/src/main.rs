@@ -33,15 +33,29 @@ struct Args {
     /// On SIGTERM, how long the current job may finish before its lease is released.
     #[arg(long, env = "SURFMAP_SHUTDOWN_GRACE_SECS", default_value_t = 60)]
     shutdown_grace_secs: u64,
+    /// Memory budget of one job in MiB: jobs estimated above it are refused, and each job's
+    /// process is capped at it (an allocation beyond it fails the job, not the service).
+    #[arg(long, env = "SURFMAP_JOB_MEMORY_MB", default_value_t = 8192)]
+    job_memory_mb: u64,
     /// Serve this worker's Prometheus metrics (stage and job durations, failures by code) at
     /// `http://ADDR/metrics`.
     #[arg(long, env = "SURFMAP_METRICS_LISTEN")]
     metrics_listen: Option<String>,
 }
 
-#[tokio::main]
-async fn main() -> std::process::ExitCode {
-    surfmap_worker::process_main("surfmap-worker", run(Args::parse())).await
+fn main() -> std::process::ExitCode {
+    // A job's child process (`surfmap-worker __run-job DIR`) runs the job and exits.
+    if let Some(code) = surfmap_worker::main_if_child() {
+        return code;
+    }
+    let args = Args::parse();
+    match tokio::runtime::Builder::new_multi_thread().enable_all().build() {
+        Ok(rt) => rt.block_on(surfmap_worker::process_main("surfmap-worker", run(args))),
+        Err(e) => {
+            eprintln!("surfmap-worker: cannot start the runtime: {e}");
+            std::process::ExitCode::from(1)
+        }
+    }
 }
 
 async fn run(a: Args) -> anyhow::Result<()> {
@@ -57,6 +71,8 @@ async fn run(a: Args) -> anyhow::Result<()> {
         time_limit: Duration::from_secs(a.time_limit_secs),
         max_vertices: a.max_vertices,
         shutdown_grace: Duration::from_secs(a.shutdown_grace_secs),
+        runner: surfmap_worker::Runner::current_exe()?,
+        job_memory_bytes: a.job_memory_mb.saturating_mul(1 << 20),
     };
     surfmap_worker::telemetry::prometheus();
     let (tx, rx) = tokio::sync::watch::channel(false);

@@ -1,7 +1,7 @@
 //! The bridge between the pipeline's `Progress` calls (on the blocking thread) and the
 //! heartbeat (on the runtime): stage names map onto one monotone job fraction.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use geom::progress::CancelToken;
 use std::sync::{Arc, Mutex};
 
 /// Where each pipeline stage starts and how much of the job it spans.
@@ -29,7 +29,7 @@ const STAGES: &[(&str, f64, f64)] = &[
 #[derive(Debug, Clone, Default)]
 pub struct Shared {
     state: Arc<Mutex<(String, f64)>>,
-    cancel: Arc<AtomicBool>,
+    cancel: CancelToken,
 }
 
 impl Shared {
@@ -37,7 +37,7 @@ impl Shared {
         self.state.lock().map(|s| s.clone()).unwrap_or_else(|p| p.into_inner().clone())
     }
     pub fn cancel(&self) {
-        self.cancel.store(true, Ordering::Relaxed);
+        self.cancel.cancel();
     }
 }
 
@@ -53,7 +53,10 @@ impl geom::progress::Progress for Shared {
         }
     }
     fn cancelled(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed)
+        self.cancel.is_cancelled()
+    }
+    fn token(&self) -> Option<CancelToken> {
+        Some(self.cancel.clone())
     }
 }
 
@@ -70,7 +73,10 @@ mod tests {
         s.report("layout", 1.0);
         assert_eq!(s.snapshot().1, 0.7);
         assert!(s.check().is_ok());
+        let side = s.silent();
+        assert!(side.check().is_ok());
         s.clone().cancel();
         assert!(s.check().is_err());
+        assert!(side.check().is_err(), "the silent half of a split sees the cancel");
     }
 }

@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options for [`relax_newton`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct NewtonOptions {
     /// Newton steps at most (0, the default, turns the stage off: it costs four to five times
     /// the smoothing sweeps for an L2 stretch about 0.001 to 0.005 lower).
@@ -44,29 +44,6 @@ pub struct NewtonOptions {
     /// Vertices of faces whose normal makes an angle with this cosine or less with the target's
     /// normal at a corner stay put (a small move could turn such a face over).
     pub min_cos: f64,
-}
-
-impl NewtonOptions {
-    /// The options a spec may carry: finite, positive step bounds and a cosine in [-1, 1].
-    ///
-    /// # Errors
-    /// A message naming the first field out of range.
-    pub fn check(&self) -> std::result::Result<(), String> {
-        let ok = |x: f64| x.is_finite() && x > 0.0;
-        if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
-            return Err(format!("options.newton.tolerance must be finite and >= 0, got {}", self.tolerance));
-        }
-        if !ok(self.max_move) {
-            return Err(format!("options.newton.max_move must be finite and > 0, got {}", self.max_move));
-        }
-        if self.max_density.is_nan() || self.max_density <= 0.0 {
-            return Err(format!("options.newton.max_density must be > 0, got {}", self.max_density));
-        }
-        if !(-1.0..=1.0).contains(&self.min_cos) {
-            return Err(format!("options.newton.min_cos must be in [-1, 1], got {}", self.min_cos));
-        }
-        Ok(())
-    }
 }
 
 impl Default for NewtonOptions {

@@ -20,7 +20,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options for [`parameterize_patches`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct PatchParamOptions {
     pub weights: Weights,
     /// Stretch-minimizing reweighting rounds after the first embedding (Yoshizawa et al.;

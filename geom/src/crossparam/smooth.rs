@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options for [`smooth`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct SmoothOptions {
     /// Sweeps at most (0 disables smoothing). After the first, a sweep visits only vertices
     /// next to one whose move lowered its star energy by more than `tolerance` (relative).

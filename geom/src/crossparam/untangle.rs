@@ -33,7 +33,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options for [`untangle`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct UntangleOptions {
     /// Largest ring count around a fold (the region starts at 2 rings and grows by 2).
     pub max_rings: usize,

@@ -37,6 +37,40 @@ impl Clusters {
     pub fn mask(&self, i: u32, j: u32) -> Vec<bool> {
         self.label.iter().map(|&l| l == i || l == j).collect()
     }
+
+    /// Anchors whose cell is not a disk: it falls apart into several pieces, or its Euler
+    /// characteristic `V − E + F` is not 1 (a handle or a tube runs through it, or it holds a
+    /// whole boundary loop). The dual layout of such cells is not cellular — the closed-ball
+    /// property of a Voronoi diagram fails — and completing it may need more anchors there.
+    pub fn non_disk(&self, mesh: &Mesh) -> Vec<u32> {
+        let mut out = Vec::new();
+        for (a, faces) in self.faces.iter().enumerate() {
+            let mut verts: Vec<VertexId> = faces.iter().flat_map(|&f| mesh.face(f)).collect();
+            verts.sort_unstable();
+            verts.dedup();
+            // Edges as sorted vertex pairs, each with the first cluster face seen on it.
+            let mut edges: HashMap<(VertexId, VertexId), usize> = HashMap::new();
+            let mut parent: Vec<usize> = (0..faces.len()).collect();
+            for (k, &f) in faces.iter().enumerate() {
+                let [x, y, z] = mesh.face(f);
+                for (u, w) in [(x, y), (y, z), (z, x)] {
+                    let key = (u.min(w), u.max(w));
+                    if let Some(&o) = edges.get(&key) {
+                        let (r, q) = (uf_find(&mut parent, k), uf_find(&mut parent, o));
+                        parent[r] = q;
+                    } else {
+                        edges.insert(key, k);
+                    }
+                }
+            }
+            let pieces = (0..faces.len()).filter(|&k| uf_find(&mut parent, k) == k).count();
+            let chi = verts.len() as i64 - edges.len() as i64 + faces.len() as i64;
+            if pieces != 1 || chi != 1 {
+                out.push(a as u32);
+            }
+        }
+        out
+    }
 }
 
 /// Clusters faces around `anchors` (multi-source Dijkstra on the face dual) and finds the cuts.
@@ -115,5 +149,10 @@ mod tests {
         let t = shapes::torus(24, 8, 1.0, 0.3);
         let c = clusters(&t, &[VertexId(0), VertexId(12 * 8)]).unwrap();
         assert_eq!(c.between(0, 1).count(), 2);
+        // Each of those two cells is a band around the tube (V - E + F = 0), not a disk; the
+        // sphere's two cells are disks.
+        assert_eq!(c.non_disk(&t), vec![0, 1]);
+        let c = clusters(&s, &[VertexId(0), VertexId::from_idx(far)]).unwrap();
+        assert!(c.non_disk(&s).is_empty());
     }
 }

@@ -24,7 +24,7 @@ const SHAPE_REACH: f64 = 0.25;
 
 /// Options of [`flip_paths`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct FlipOptions {
     /// Sweeps over all paths (0 disables flipping).
     pub rounds: usize,

@@ -66,7 +66,7 @@ pub struct Patch {
 
 /// Options shared by the layout builders.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct LayoutOptions {
     /// Edge nodes per edge (the paper's `b` and a cap).
     pub edge_nodes: crate::geodesic::EdgeNodeOptions,

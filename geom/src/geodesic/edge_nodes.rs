@@ -18,7 +18,7 @@ use std::cell::RefCell;
 
 /// Options for building an [`EdgeNodeGraph`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct EdgeNodeOptions {
     /// Minimal number of edge nodes per edge (`b` in the paper).
     pub min_nodes: u32,

@@ -24,7 +24,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options for [`evaluate_map`].
 #[derive(Debug, Clone, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct MetricsOptions {
     /// Surface samples per direction for Hausdorff / RMS (the evaluator's default is 100000).
     pub samples: usize,

@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options for [`parameterize_disk`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct DiskParamOptions {
     pub weights: Weights,
     pub boundary: BoundaryShape,

@@ -166,8 +166,9 @@ pub(super) fn choose_global(
     };
     let lengths: Vec<f64> = path_len(rs, source).iter().zip(path_len(rt, target)).map(|(a, b)| 0.5 * (a + b)).collect();
     let lengths = (opts.metric == DomainMetric::PathLengths).then_some(&lengths[..]);
+    let mut side = progress.silent();
     let (gs, gt) = both(
-        || global_param(target, patches, ta, &it, Some(rt), lengths, opts, &mut crate::progress::NoProgress),
+        || global_param(target, patches, ta, &it, Some(rt), lengths, opts, &mut side),
         || global_param(source, patches, sa, &is, Some(rs), lengths, opts, progress),
     )?;
     let (gs, gt) = match (gs, gt) {

@@ -5,6 +5,8 @@
 mod artifacts;
 mod global_choice;
 mod job;
+mod memory;
+mod ranges;
 mod remesh_spec;
 mod run;
 mod run_features;
@@ -13,6 +15,7 @@ mod run_quad;
 mod spec;
 
 pub use job::{Job, JobOutput, METHODS, run_job};
+pub use ranges::{MAX_EDGE_NODES, MAX_METRIC_SAMPLES, MAX_MORPH_FRAMES};
 pub use remesh_spec::{
     Interpolation, LevelSchedule, MAX_MODELS, MorphDomain, MorphOptions, QuadMethod, QuadOptions, RemeshSpec,
 };

@@ -142,29 +142,8 @@ impl RemeshSpec {
                 .into());
             }
         }
+        self.options.check_ranges(n)?;
         let o = &self.options;
-        if !(1..=crate::quad::remesh::MAX_LEVEL).contains(&o.level) {
-            return Err(InputError::Spec(format!(
-                "level {} is outside 1..={}",
-                o.level,
-                crate::quad::remesh::MAX_LEVEL
-            ))
-            .into());
-        }
-        if let Some(e) = o.adaptive_epsilon
-            && !(e.is_finite() && e > 0.0)
-        {
-            return Err(InputError::Spec(format!("adaptive_epsilon must be positive, got {e}")).into());
-        }
-        if o.morph.weights.iter().any(|w| w.len() != n || w.iter().any(|x| !x.is_finite())) {
-            return Err(InputError::Spec(format!("every morph weight vector needs {n} finite weights")).into());
-        }
-        if o.morph.schedule.iter().any(|s| !(s.start.is_finite() && s.speed.is_finite() && s.speed > 0.0)) {
-            return Err(InputError::Spec("wavelet schedules need finite starts and positive speeds".into()).into());
-        }
-        if o.morph.frames > 10_000 {
-            return Err(InputError::Spec(format!("{} morph frames exceed the limit 10000", o.morph.frames)).into());
-        }
         let rows: Vec<&Vec<u64>> = self.anchors.iter().chain(&o.feature_anchors).collect();
         if self.anchors.len() < 4 {
             return Err(InputError::Anchors(format!(

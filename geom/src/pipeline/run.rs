@@ -210,6 +210,21 @@ pub(super) fn measure_direction(
     Ok((embedded, metrics))
 }
 
+/// A layout conflict's message, naming the source anchors whose Voronoi cells are not disks
+/// (where a handle or tube is not separated by the anchors, the usual cause), if any.
+fn with_cell_hint(m: String, source: &Mesh, anchors: &[VertexId]) -> Error {
+    let bad = crate::domain::cuts::clusters(source, anchors).map(|c| c.non_disk(source)).unwrap_or_default();
+    let m = if bad.is_empty() {
+        m
+    } else {
+        format!(
+            "{m}; the source Voronoi cells of anchors {bad:?} (indices into the anchor list) are not disks \
+             (each holds a handle, or wraps a tube, that no anchor lies on): add anchors on it"
+        )
+    };
+    InputError::LayoutConflict(m).into()
+}
+
 /// The maps both ways, with what produced them.
 pub struct MapResult {
     pub source_to_target: SurfaceMap,
@@ -290,6 +305,7 @@ pub fn run_map(
                 }
                 attempt += 1;
             }
+            Err(Error::Input(InputError::LayoutConflict(m))) => return Err(with_cell_hint(m, source, &sa)),
             Err(e) => return Err(e),
         }
     };
@@ -298,8 +314,9 @@ pub fn run_map(
     stats.flipped = crate::domain::flip::flip_paths(&mut st, &mut tt, &o.layout.flip, progress)?.flipped;
     clock.lap("flip");
     let rounds = o.layout.straighten_rounds;
+    let mut side = progress.silent();
     let (a, b) = both(
-        || crate::domain::straighten::straighten(&mut tt, rounds, &mut crate::progress::NoProgress),
+        || crate::domain::straighten::straighten(&mut tt, rounds, &mut side),
         || crate::domain::straighten::straighten(&mut st, rounds, progress),
     )?;
     stats.straightened = a? + b?;
@@ -312,8 +329,9 @@ pub fn run_map(
     let (rs, rt) = both(move || refine(tt_ref, pr), || refine(&st, &patches))?;
     let (rs, rt) = (rs?, rt?);
     clock.lap("refine");
+    let mut side = progress.silent();
     let (ps, pt) = both(
-        || parameterize_patches(&rt, &patches, &ta, &o.param, &mut crate::progress::NoProgress),
+        || parameterize_patches(&rt, &patches, &ta, &o.param, &mut side),
         || parameterize_patches(&rs, &patches, &sa, &o.param, progress),
     )?;
     let (ps, pt) = (ps?, pt?);
@@ -339,9 +357,10 @@ pub fn run_map(
          anchors: &[(VertexId, VertexId)],
          progress: &mut dyn Progress,
          smoothed: &mut dyn FnMut()| { finish_direction(from, to, map, fixed, anchors, o, progress, smoothed) };
+    let mut side = progress.silent();
     let (a, b) = match contender {
         None => both(
-            || finish(target, source, t2s, &ta, &rev, &mut crate::progress::NoProgress, &mut || {}),
+            || finish(target, source, t2s, &ta, &rev, &mut side, &mut || {}),
             || finish(source, target, s2t, &sa, &pairs, progress, &mut || clock.lap("smooth")),
         )?,
         Some((gs2t, gt2s)) => {
@@ -359,7 +378,7 @@ pub fn run_map(
                 Ok((p, g, qp, qg))
             };
             let (x, y) = both(
-                || relax_both(target, source, t2s, gt2s, &ta, &mut crate::progress::NoProgress),
+                || relax_both(target, source, t2s, gt2s, &ta, &mut side),
                 || relax_both(source, target, s2t, gs2t, &sa, progress),
             )?;
             let ((ps, gs, qps, qgs), (pt, gt, qpt, qgt)) = (x?, y?);
@@ -378,7 +397,7 @@ pub fn run_map(
                 Ok((m, r, e, met))
             };
             both(
-                || measure(target, source, t2s, r2, &rev, &mut crate::progress::NoProgress),
+                || measure(target, source, t2s, r2, &rev, &mut side),
                 || measure(source, target, s2t, r1, &pairs, progress),
             )?
         }
@@ -411,4 +430,30 @@ pub fn run_map(
     arts.push(Artifact { name: "metrics.json".into(), content_type: "application/json", bytes: json });
     progress.report("done", 1.0);
     Ok((report, arts))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+    use crate::pipeline::MapOptions;
+    use crate::progress::NoProgress;
+
+    /// Eight anchors around one meridian of a torus: every Voronoi cell is a band around the
+    /// long way of the torus, not a disk. With completion cut short, the conflict names them.
+    #[test]
+    fn a_layout_conflict_names_the_cells_that_are_not_disks() {
+        let m = shapes::torus(24, 8, 1.0, 0.3);
+        let anchors: Vec<[u64; 2]> = (0..8).map(|j| [j, j]).collect();
+        let mut options = MapOptions::default();
+        options.layout.max_attempts = 1;
+        options.layout.rebuilds = 0;
+        options.layout.greedy_fallback = false;
+        let spec = JobSpec { method: Method::Voronoi, anchors, features: Vec::new(), options };
+        let Err(Error::Input(e @ InputError::LayoutConflict(_))) = run_map(&spec, &m, &m, &mut NoProgress) else {
+            panic!("expected a layout conflict");
+        };
+        let msg = e.to_string();
+        assert!(msg.contains("anchors [0, 1, 2, 3, 4, 5, 6, 7]") && msg.contains("not disks"), "{msg}");
+    }
 }

@@ -15,7 +15,7 @@ use crate::io::{self, Format};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, P3, VertexId};
 use crate::metrics::MapMetrics;
-use crate::progress::{NoProgress, Progress};
+use crate::progress::Progress;
 use crate::topology::SurfacePoint;
 use serde::Serialize;
 use serde_json::json;
@@ -257,8 +257,9 @@ pub(super) fn finish_pair(
     let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).chain(fixed.1.iter().copied()).collect();
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
     progress.report("smooth", 0.0);
+    let mut side = progress.silent();
     let (a, b) = both(
-        || finish_direction(target, source, t2s, &ta, &rev, o, &mut NoProgress, &mut || {}),
+        || finish_direction(target, source, t2s, &ta, &rev, o, &mut side, &mut || {}),
         || finish_direction(source, target, s2t, &sa, pairs, o, progress, &mut || {}),
     )?;
     let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = (a?, b?);

@@ -227,18 +227,7 @@ impl JobSpec {
             .into());
         }
         let n = self.anchors.len();
-        if let Some(d) = self.options.dihedral_threshold_deg
-            && !(d.is_finite() && d > 0.0 && d <= 180.0)
-        {
-            return Err(InputError::Spec(format!("options.dihedral_threshold_deg must be in (0, 180], got {d}")).into());
-        }
-        let w = self.options.smoothing.area_weight;
-        if !(w.is_finite() && w >= 0.0) {
-            return Err(
-                InputError::Spec(format!("options.smoothing.area_weight must be finite and >= 0, got {w}")).into()
-            );
-        }
-        self.options.newton.check().map_err(InputError::Spec)?;
+        self.options.check_ranges()?;
         if self.features.len() > MAX_FEATURES {
             return Err(InputError::Features(format!(
                 "{} feature curves exceed the limit {MAX_FEATURES}",
@@ -318,7 +307,7 @@ mod tests {
         assert!(spec.validate(&m, &m).is_ok());
         spec.options.smoothing.area_weight = -1.0;
         let e = spec.validate(&m, &m).unwrap_err();
-        assert_eq!(e.code(), "invalid_spec", "{e}");
+        assert_eq!(e.code(), "option_out_of_range", "{e}");
         assert!(e.to_string().contains("area_weight"), "{e}");
     }
 
@@ -342,7 +331,7 @@ mod tests {
             let mut bad = spec.clone();
             set(&mut bad.options.newton);
             let e = bad.validate(&m, &m).unwrap_err();
-            assert_eq!(e.code(), "invalid_spec", "{e}");
+            assert_eq!(e.code(), "option_out_of_range", "{e}");
             assert!(e.to_string().contains(name), "{name}: {e}");
         }
     }

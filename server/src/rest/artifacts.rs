@@ -11,7 +11,7 @@ use axum::response::{IntoResponse, Response};
 
 /// Every file `surfmap map` writes for this job (empty until it succeeds).
 #[utoipa::path(get, path = "/v1/jobs/{id}/artifacts", tag = "artifacts", params(("id" = String, Path)),
-    responses((status = 200, body = ArtifactList), (status = 404, body = ErrorBody)))]
+    responses((status = 200, description = "the job's artifacts", body = ArtifactList), (status = 404, description = "unknown job", body = ErrorBody)))]
 pub async fn list_artifacts(
     State(st): State<AppState>,
     Owner(owner): Owner,
@@ -25,7 +25,7 @@ pub async fn list_artifacts(
 #[utoipa::path(get, path = "/v1/jobs/{id}/artifacts/{name}", tag = "artifacts",
     params(("id" = String, Path), ("name" = String, Path)),
     responses((status = 200, description = "the file, with its content type"),
-        (status = 400, description = "a name with a path in it", body = ErrorBody), (status = 404, body = ErrorBody)))]
+        (status = 400, description = "a name with a path in it", body = ErrorBody), (status = 404, description = "unknown job or artifact", body = ErrorBody)))]
 pub async fn get_artifact(
     State(st): State<AppState>,
     Owner(owner): Owner,

@@ -16,6 +16,7 @@ use surfmap_store::BlobStore;
 
 /// Filters and paging of `GET /v1/jobs`.
 #[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct ListQuery {
     /// queued | running | succeeded | failed | cancelled
     pub state: Option<String>,
@@ -46,6 +47,13 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
         match name.as_str() {
             "source" => source = Some(mesh_part(st, owner, &bytes, file).await?),
             "target" => target = Some(mesh_part(st, owner, &bytes, file).await?),
+            "spec" if bytes.len() > st.service.limits.max_json_bytes => {
+                return Err(ApiError::too_large(format!(
+                    "the spec part of {} bytes exceeds the limit of {} for JSON",
+                    bytes.len(),
+                    st.service.limits.max_json_bytes
+                )));
+            }
             "spec" => spec = Some(bytes.to_vec()),
             "mesh" => meshes.push(mesh_part(st, owner, &bytes, file).await?),
             other => return Err(ApiError::bad_request("invalid_multipart", format!("unexpected part {other:?}"))),
@@ -62,11 +70,11 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
 /// Validates a job against its meshes and queues it.
 #[utoipa::path(post, path = "/v1/jobs", tag = "jobs", request_body = SubmitJob,
     params(("Idempotency-Key" = Option<String>, Header, description = "retries with the same key return the same job")),
-    responses((status = 202, body = JobView, headers(("Location" = String))),
+    responses((status = 202, description = "queued (or the job an earlier request with this Idempotency-Key made)", body = JobView, headers(("Location" = String, description = "the job's URL"))),
         (status = 400, description = "bad spec or unknown method", body = ErrorBody),
         (status = 404, description = "unknown mesh", body = ErrorBody),
         (status = 409, description = "idempotency key reused", body = ErrorBody),
-        (status = 422, description = "genus mismatch, anchors out of range", body = ErrorBody)))]
+        (status = 422, description = "genus mismatch, anchors out of range, an option out of its range, over the memory budget", body = ErrorBody)))]
 pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Request) -> Result<Response, ApiError> {
     let key = req.headers().get("idempotency-key").and_then(|v| v.to_str().ok()).map(str::to_string);
     let (meshes, spec) = if is_multipart(req.headers()) {
@@ -76,7 +84,9 @@ pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Re
         multipart_job(&st, &owner, mp).await?
     } else {
         let (parts, body) = req.into_parts();
-        let bytes = read_limited(&parts.headers, body, st.service.limits.max_body_bytes).await?;
+        // A JSON job carries ids and a spec, never mesh bytes: its own small limit, checked
+        // before anything is parsed.
+        let bytes = read_limited(&parts.headers, body, st.service.limits.max_json_bytes).await?;
         let s: SubmitJob = serde_json::from_slice(&bytes).map_err(|e| {
             ApiError::bad_request(
                 "invalid_request",
@@ -109,7 +119,7 @@ pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Re
 
 /// State, stage, progress, attempts, timestamps, error and result links of a job.
 #[utoipa::path(get, path = "/v1/jobs/{id}", tag = "jobs", params(("id" = String, Path)),
-    responses((status = 200, body = JobView), (status = 404, body = ErrorBody)))]
+    responses((status = 200, description = "the job", body = JobView), (status = 404, description = "unknown job", body = ErrorBody)))]
 pub async fn get_job(
     State(st): State<AppState>,
     Owner(owner): Owner,
@@ -119,7 +129,7 @@ pub async fn get_job(
 }
 
 /// Jobs, newest first, with filters and cursor paging.
-#[utoipa::path(get, path = "/v1/jobs", tag = "jobs", params(ListQuery), responses((status = 200, body = JobPage)))]
+#[utoipa::path(get, path = "/v1/jobs", tag = "jobs", params(ListQuery), responses((status = 200, description = "a page of jobs, newest first", body = JobPage), (status = 400, description = "a bad filter or limit", body = ErrorBody)))]
 pub async fn list_jobs(
     State(st): State<AppState>,
     Owner(owner): Owner,
@@ -137,7 +147,7 @@ pub async fn list_jobs(
 
 /// Cancels a queued job at once; a running job stops at its next check.
 #[utoipa::path(post, path = "/v1/jobs/{id}/cancel", tag = "jobs", params(("id" = String, Path)),
-    responses((status = 200, body = JobView), (status = 404, body = ErrorBody)))]
+    responses((status = 200, description = "cancelled, or cancellation requested of a running job", body = JobView), (status = 404, description = "unknown job", body = ErrorBody)))]
 pub async fn cancel_job(
     State(st): State<AppState>,
     Owner(owner): Owner,
@@ -150,7 +160,7 @@ pub async fn cancel_job(
 /// the stream ends after a terminal state.
 #[utoipa::path(get, path = "/v1/jobs/{id}/events", tag = "jobs", params(("id" = String, Path)),
     responses((status = 200, content_type = "text/event-stream", description = "`event: job` with a JobView as data"),
-        (status = 404, body = ErrorBody)))]
+        (status = 404, description = "unknown job", body = ErrorBody)))]
 pub async fn job_events(
     State(st): State<AppState>,
     Owner(owner): Owner,

@@ -11,10 +11,16 @@ use axum::http::StatusCode;
 
 /// `?format=` for content that is ambiguous.
 #[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
 pub struct FormatQuery {
     /// obj, off, ply or stl; only used when the content does not tell.
     pub format: Option<String>,
 }
+
+/// A mesh file's bytes, as the OpenAPI document describes an upload body.
+#[derive(utoipa::ToSchema)]
+#[schema(value_type = String, format = Binary)]
+pub struct MeshBytes(#[allow(dead_code)] Vec<u8>);
 
 /// The first file part of a multipart body and the format its file name suggests.
 pub async fn first_file(mut mp: Multipart) -> Result<(Vec<u8>, Option<&'static str>), ApiError> {
@@ -30,8 +36,8 @@ pub async fn first_file(mut mp: Multipart) -> Result<(Vec<u8>, Option<&'static s
 
 /// Uploads one mesh (OBJ, OFF, PLY or STL); returns its content address and summary.
 #[utoipa::path(post, path = "/v1/meshes", tag = "meshes", params(FormatQuery),
-    request_body(content = Vec<u8>, content_type = "application/octet-stream", description = "mesh bytes, or multipart with a `file` part"),
-    responses((status = 201, body = MeshView), (status = 413, body = ErrorBody), (status = 422, description = "invalid mesh", body = ErrorBody)))]
+    request_body(content = MeshBytes, content_type = "application/octet-stream", description = "mesh bytes, or multipart with a `file` part"),
+    responses((status = 201, description = "stored (or already stored: the id is the content's sha256)", body = MeshView), (status = 413, description = "body or mesh over the limits", body = ErrorBody), (status = 422, description = "invalid mesh", body = ErrorBody)))]
 pub async fn upload_mesh(
     State(st): State<AppState>,
     Owner(owner): Owner,

@@ -23,8 +23,15 @@ pub async fn readyz(State(st): State<AppState>) -> Result<Json<serde_json::Value
 
 /// Prometheus text: queue depth, jobs by state, stage and job duration histograms by method,
 /// failures by code, rejected requests by code.
-#[utoipa::path(get, path = "/metrics", tag = "ops", responses((status = 200, content_type = "text/plain", description = "Prometheus exposition")))]
-pub async fn metrics(State(st): State<AppState>) -> Result<impl IntoResponse, ApiError> {
+/// With `--metrics-token`, only that bearer token may read it; with API tokens and no metrics
+/// token, nobody may (the figures span every tenant).
+#[utoipa::path(get, path = "/metrics", tag = "ops", responses((status = 200, content_type = "text/plain", description = "Prometheus exposition"),
+    (status = 401, description = "the metrics token is required", body = crate::error::ErrorBody)))]
+pub async fn metrics(
+    State(st): State<AppState>,
+    headers: axum::http::HeaderMap,
+) -> Result<impl IntoResponse, ApiError> {
+    st.auth.metrics_allowed(headers.get(header::AUTHORIZATION).and_then(|v| v.to_str().ok()))?;
     for (state, n) in st.service.store.count_by_state().await? {
         metrics::gauge!("surfmap_jobs", "state" => state.as_str()).set(n as f64);
         if state == surfmap_store::JobState::Queued {

@@ -29,7 +29,7 @@ use solve::{Rows, State};
 
 /// Options for [`global_param`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
+#[serde(default, deny_unknown_fields)]
 pub struct GlobalParamOptions {
     /// Use the global map (closed meshes); `false` keeps the per-patch maps.
     pub enabled: bool,

@@ -1,0 +1,62 @@
+//! A job's peak memory, estimated before it runs from its meshes' sizes and its options, so a
+//! service can refuse a job that would not fit its budget instead of letting it die
+//! half-way. The model is linear in what the job allocates in bulk; its constants are fitted
+//! to measured peaks (the resident set of `surfmap map` / `surfmap remesh`; `bench/NOTES.md`)
+//! and rounded up, so the estimate errs high.
+
+use super::job::Job;
+use crate::topology::Summary;
+
+/// Fixed cost of any job's process: its mapped executable, thread stacks and two allocator
+/// arenas' reservations (the budget caps the address space, not the resident set).
+const BASE: u64 = 320 << 20;
+/// Bytes per mesh vertex of a pair job at the default options (both meshes, their layouts,
+/// charts, factorizations and the maps both ways), per input vertex.
+const PER_VERTEX: u64 = 6 << 10;
+/// Bytes per layout edge node (positions, graph adjacency, search state).
+const PER_EDGE_NODE: u64 = 96;
+/// Bytes per metric sample (point, nearest face, distances), per direction.
+const PER_SAMPLE: u64 = 160;
+/// Bytes per remeshed sample of a `quad` job (position, normal, indices, per model).
+const PER_REMESH_SAMPLE: u64 = 256;
+/// Bytes per written vertex of an OBJ output (text held in memory before it is stored).
+const PER_OUTPUT_VERTEX: u64 = 96;
+
+impl Job {
+    /// Estimated peak memory in bytes on meshes with these summaries (an upper estimate).
+    pub fn memory_estimate(&self, summaries: &[Summary]) -> u64 {
+        let vertices: u64 = summaries.iter().map(|s| s.vertices as u64).sum();
+        let edges: u64 = summaries.iter().map(|s| s.edges as u64).sum();
+        let bytes = match self {
+            Job::Map(spec) => {
+                let o = &spec.options;
+                let n = &o.layout.edge_nodes;
+                let per_edge = u64::from(n.min_nodes.max(1)) * u64::from(n.ring_factor.max(1));
+                let nodes = edges.saturating_mul(per_edge.min(u64::from(n.max_nodes.max(1))));
+                PER_VERTEX
+                    .saturating_mul(vertices)
+                    .saturating_add(PER_EDGE_NODE.saturating_mul(nodes))
+                    .saturating_add(PER_SAMPLE.saturating_mul(2 * o.metric_samples as u64))
+            }
+            Job::Remesh(spec) => {
+                let o = &spec.options;
+                let models = summaries.len() as u64;
+                let genus = summaries.first().map_or(0, |s| s.genus.max(0) as u64);
+                let rows = (spec.anchors.len() + o.feature_anchors.len()) as u64;
+                let patches = 2 * rows + 8 * genus + 2;
+                let side = |level: u32| (1u64 << level.min(16)) + 1;
+                let per_patch = side(o.level) * side(o.level);
+                let image = o.image_level.unwrap_or(o.level.min(8));
+                let per_image = if image == 0 { 0 } else { side(image) * side(image) };
+                let samples = patches.saturating_mul(per_patch + per_image);
+                let outputs = (o.morph.frames as u64 + o.morph.weights.len() as u64 + 2) * patches * per_patch;
+                PER_VERTEX
+                    .saturating_mul(vertices)
+                    .saturating_add(PER_REMESH_SAMPLE.saturating_mul(samples).saturating_mul(models))
+                    .saturating_add(PER_OUTPUT_VERTEX.saturating_mul(outputs))
+                    .saturating_add(PER_SAMPLE.saturating_mul(2 * o.metric_samples as u64 * models))
+            }
+        };
+        BASE.saturating_add(bytes)
+    }
+}

@@ -58,6 +58,7 @@ impl Surfmap for GrpcApi {
         let o = owner(&self.state, &req)?;
         let r = req.into_inner();
         let hint = Some(r.format_hint.as_str()).filter(|h| !h.is_empty());
+        let _held = self.state.service.limits.uploads.reserve(r.data.len())?;
         let m = self.state.service.upload_mesh(&o, r.data, hint).await?;
         Ok(Response::new(pb::MeshInfo {
             id: m.id,

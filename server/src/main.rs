@@ -37,6 +37,10 @@ struct Args {
     /// Largest JSON request body (a job's spec with its anchors and features) in MiB.
     #[arg(long, env = "SURFMAP_MAX_JSON_MB", default_value_t = 8)]
     max_json_mb: usize,
+    /// Memory that concurrent uploads may hold while they are read and parsed, in MiB (an
+    /// upload reserves four times its body; over the budget: 429 with Retry-After).
+    #[arg(long, env = "SURFMAP_UPLOAD_MEMORY_MB", default_value_t = 1024)]
+    upload_memory_mb: usize,
     /// Largest mesh in vertices.
     #[arg(long, env = "SURFMAP_MAX_VERTICES", default_value_t = 2_000_000)]
     max_vertices: u64,
@@ -83,6 +87,7 @@ async fn run(a: Args) -> anyhow::Result<()> {
     let limits = Limits {
         max_body_bytes: a.max_body_mb.saturating_mul(1 << 20),
         max_json_bytes: a.max_json_mb.saturating_mul(1 << 20),
+        uploads: surfmap_server::service::UploadBudget::new(a.upload_memory_mb.saturating_mul(1 << 20)),
         max_vertices: a.max_vertices,
         max_attempts: a.max_attempts,
         job_memory_bytes: a.job_memory_mb.saturating_mul(1 << 20),

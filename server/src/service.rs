@@ -10,6 +10,38 @@ use geom::pipeline::Job;
 use std::time::Duration;
 use surfmap_store::{ArtifactRef, BlobStore, JobFilter, JobRecord, JobState, MeshRecord, NewJob, Store, now_ms};
 
+/// The memory that uploads being read and parsed may hold at once, shared by all requests.
+#[derive(Debug, Clone)]
+pub struct UploadBudget {
+    permits: std::sync::Arc<tokio::sync::Semaphore>,
+    total_mib: u32,
+}
+
+impl UploadBudget {
+    /// A budget of `bytes` (at least 1 MiB).
+    pub fn new(bytes: usize) -> UploadBudget {
+        let total_mib = u32::try_from((bytes >> 20).max(1)).unwrap_or(u32::MAX >> 4);
+        UploadBudget { permits: std::sync::Arc::new(tokio::sync::Semaphore::new(total_mib as usize)), total_mib }
+    }
+
+    /// Reserves what an upload of `body` bytes holds while it is read and parsed (the body and
+    /// the mesh built from it, about four times the body), before the body is read.
+    ///
+    /// # Errors
+    /// 429 `uploads_busy` with `Retry-After` when concurrent uploads hold the budget.
+    pub fn reserve(&self, body: usize) -> Result<tokio::sync::OwnedSemaphorePermit, ApiError> {
+        let mib =
+            u32::try_from(body.saturating_mul(4).div_ceil(1 << 20).max(1)).unwrap_or(u32::MAX).min(self.total_mib);
+        self.permits.clone().try_acquire_many_owned(mib).map_err(|_| {
+            ApiError::busy(
+                "uploads_busy",
+                format!("concurrent uploads hold the server's upload memory ({} MiB); retry shortly", self.total_mib),
+                1,
+            )
+        })
+    }
+}
+
 /// Sizes and retry policy the service enforces.
 #[derive(Debug, Clone)]
 pub struct Limits {
@@ -25,6 +57,8 @@ pub struct Limits {
     pub watch_interval: Duration,
     /// Memory budget of one job: a job whose estimate exceeds it is refused at submission.
     pub job_memory_bytes: u64,
+    /// Memory that concurrent uploads may hold.
+    pub uploads: UploadBudget,
 }
 
 impl Default for Limits {
@@ -36,6 +70,7 @@ impl Default for Limits {
             max_attempts: 3,
             watch_interval: Duration::from_millis(200),
             job_memory_bytes: surfmap_worker::DEFAULT_JOB_MEMORY_BYTES,
+            uploads: UploadBudget::new(1 << 30),
         }
     }
 }

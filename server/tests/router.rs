@@ -390,3 +390,21 @@ async fn spec_bombs_nested_unknown_fields_and_budget_are_refused_at_submission()
     let (_, list) = json_call(&small, "GET", "/v1/jobs", Body::empty()).await;
     assert_eq!(list["jobs"].as_array().map(Vec::len), Some(0), "{list}");
 }
+
+/// Concurrent uploads share one memory budget: while others hold it, an upload is refused
+/// with 429 and Retry-After before its body is read; once released, it goes through.
+#[tokio::test]
+async fn uploads_over_the_shared_memory_budget_get_429() {
+    let mut t = setup().await;
+    t.state.service.limits.uploads = surfmap_server::service::UploadBudget::new(4 << 20);
+    let (s, _) = sphere_pair();
+    let held = t.state.service.limits.uploads.reserve(1 << 20).unwrap();
+    let req = Request::post("/v1/meshes").header("content-length", s.len()).body(Body::from(s.clone())).unwrap();
+    let (st, headers, body) = call(&t, req).await;
+    let e: Value = serde_json::from_slice(&body).unwrap();
+    assert_eq!((st, e["code"].as_str()), (StatusCode::TOO_MANY_REQUESTS, Some("uploads_busy")), "{e}");
+    assert_eq!(headers["retry-after"], "1");
+    drop(held);
+    let req = Request::post("/v1/meshes").header("content-length", s.len()).body(Body::from(s)).unwrap();
+    assert_eq!(call(&t, req).await.0, StatusCode::CREATED);
+}

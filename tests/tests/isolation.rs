@@ -10,12 +10,12 @@ use std::time::{Duration, Instant};
 
 static ONE_AT_A_TIME: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
 
-/// The SMPL pair subdivided twice (110k vertices each) with long smoothing: a job that runs
-/// for minutes unless stopped, and spends most of it in the `smooth` stage.
+/// The SMPL pair subdivided once (27.5k vertices each) with smoothing that never converges
+/// early: a job that runs for minutes unless stopped, nearly all of it in the `smooth` stage.
 async fn long_job(api: &Api) -> String {
     let fine = |name: &str| {
         let m = geom::io::read_path(&shared(name), &Default::default()).unwrap().mesh;
-        geom::io::write(&geom::mesh::shapes::subdivide(&m, 2), geom::io::Format::Obj)
+        geom::io::write(&geom::mesh::shapes::subdivide(&m, 1), geom::io::Format::Obj)
     };
     let (_, s) = api.upload_bytes(fine(SMPL.0)).await;
     let (_, t) = api.upload_bytes(fine(SMPL.1)).await;
@@ -74,10 +74,10 @@ async fn cancel_and_time_limit_land_within_a_second_in_the_longest_stage() {
     let api = Api::new(&base);
     let id = long_job(&api).await;
     wait_stage(&api, &id, None).await;
-    let started = Instant::now();
-    let (j, took) = time_to_end(&api, &id, started).await;
+    let (j, _) = time_to_end(&api, &id, Instant::now()).await;
     assert_eq!((j["state"].as_str(), j["error"]["code"].as_str()), (Some("failed"), Some("time_limit")), "{j}");
-    assert!(took < Duration::from_secs(5), "the 4 s limit ended the job after {took:?} of running");
+    let ran = j["finished_at_ms"].as_i64().unwrap() - j["started_at_ms"].as_i64().unwrap();
+    assert!((4000..5000).contains(&ran), "the 4 s limit ended the job after {ran} ms: {j}\n{}", _server.log_text());
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -110,8 +110,14 @@ async fn a_job_process_that_dies_fails_the_job_not_the_server() {
     let api = Api::new(&base);
     let id = long_job(&api).await;
     for attempt in 1..=2 {
-        let j = wait_stage(&api, &id, Some("smooth")).await;
-        assert_eq!(j["attempts"], attempt, "{j}");
+        let seen = wait_for(Duration::from_secs(300), || {
+            let (api, id) = (api.clone(), id.clone());
+            async move {
+                let j = api.job(&id).await;
+                (j["state"] == "running" && j["stage"] == "smooth" && j["attempts"] == attempt).then_some(())
+            }
+        });
+        assert!(seen.await.is_some(), "attempt {attempt} never reached the smooth stage: {}", api.job(&id).await);
         let children = std::process::Command::new("pgrep").arg("-P").arg(server.pid().to_string()).output().unwrap();
         let pids = String::from_utf8_lossy(&children.stdout).to_string();
         let pid = pids.split_whitespace().next().unwrap_or_else(|| panic!("no job process under the server"));
@@ -130,9 +136,10 @@ async fn a_job_process_that_dies_fails_the_job_not_the_server() {
 }
 
 /// The job process caps its own address space: a job that needs more than its budget aborts
-/// (and writes no result) instead of growing.
-#[test]
-fn the_job_process_aborts_above_its_memory_cap() {
+/// or fails with `out_of_memory` instead of growing.
+#[tokio::test]
+async fn the_job_process_aborts_above_its_memory_cap() {
+    let _one = ONE_AT_A_TIME.lock().await;
     let dir = tempfile::tempdir().unwrap();
     let spec = identity_spec("voronoi", 24);
     for (i, name) in [SMPL.0, SMPL.1].iter().enumerate() {
@@ -159,7 +166,16 @@ fn the_job_process_aborts_above_its_memory_cap() {
     let out = child.wait_with_output().unwrap();
     use std::os::unix::process::ExitStatusExt;
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.signal(), Some(6), "the job did not abort under a 400 MiB cap: {:?}\n{stderr}", out.status);
-    assert!(stderr.contains("memory allocation"), "{stderr}");
-    assert!(!dir.path().join("result.json").exists());
+    let result = std::fs::read_to_string(dir.path().join("result.json")).unwrap_or_default();
+    // Either an allocation that cannot report failure aborts the process, or a solver reports
+    // it and the job fails with `out_of_memory`.
+    if out.status.signal() == Some(6) {
+        assert!(stderr.contains("memory allocation"), "{stderr}");
+        assert!(result.is_empty());
+    } else {
+        let r: serde_json::Value =
+            serde_json::from_str(&result).unwrap_or_else(|_| panic!("{:?}\n{stderr}", out.status));
+        assert_eq!(r["Failed"]["code"], "out_of_memory", "{r}");
+        assert!(r["Failed"]["message"].as_str().unwrap().contains("400 MiB"), "{r}");
+    }
 }

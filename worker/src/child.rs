@@ -113,6 +113,13 @@ fn run(dir: &Path) -> std::io::Result<()> {
     }
     let output = match execute(dir, &input) {
         Ok(o) => o,
+        // A solver that reports its allocation failing under the cap (faer does) is the budget,
+        // not the numerics. Allocations that cannot report it abort the process instead.
+        Err(e) if e.to_string().contains("OutOfMemory") => ChildOutput::Failed {
+            code: "out_of_memory".into(),
+            message: format!("the job needs more than its memory budget of {} MiB ({e})", input.memory_bytes >> 20),
+            internal: false,
+        },
         Err(e) => ChildOutput::Failed {
             code: e.code().to_string(),
             message: e.to_string(),

@@ -32,8 +32,18 @@ pub(crate) enum RunError {
 type ThreadResult = geom::Result<(geom::pipeline::JobOutput, Vec<geom::pipeline::Artifact>)>;
 
 pub(crate) enum Running {
-    Thread { handle: JoinHandle<ThreadResult>, result: Option<Result<ThreadResult, tokio::task::JoinError>> },
-    Process { child: tokio::process::Child, dir: tempfile::TempDir, status: Option<std::io::Result<ExitStatus>> },
+    Thread {
+        handle: JoinHandle<ThreadResult>,
+        result: Option<Result<ThreadResult, tokio::task::JoinError>>,
+    },
+    Process {
+        child: tokio::process::Child,
+        /// Held until the run is collected: the child exits when it closes (and
+        /// `Child::wait` would close it if it stayed in `child`).
+        _stdin: Option<tokio::process::ChildStdin>,
+        dir: tempfile::TempDir,
+        status: Option<std::io::Result<ExitStatus>>,
+    },
 }
 
 impl Running {
@@ -102,7 +112,8 @@ impl Running {
                         }
                     });
                 }
-                Ok(Running::Process { child, dir, status: None })
+                let _stdin = child.stdin.take();
+                Ok(Running::Process { child, _stdin, dir, status: None })
             }
         }
     }

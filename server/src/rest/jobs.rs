@@ -78,6 +78,14 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
 pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Request) -> Result<Response, ApiError> {
     let key = req.headers().get("idempotency-key").and_then(|v| v.to_str().ok()).map(str::to_string);
     let (meshes, spec) = if is_multipart(req.headers()) {
+        // Mesh parts are uploads: they share the upload memory budget.
+        let declared = req
+            .headers()
+            .get(header::CONTENT_LENGTH)
+            .and_then(|v| v.to_str().ok())
+            .and_then(|v| v.parse::<usize>().ok());
+        let limit = st.service.limits.max_body_bytes;
+        let _held = st.service.limits.uploads.reserve(declared.unwrap_or(limit).min(limit))?;
         let mp = Multipart::from_request(req, &st)
             .await
             .map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;

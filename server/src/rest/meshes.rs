@@ -37,13 +37,20 @@ pub async fn first_file(mut mp: Multipart) -> Result<(Vec<u8>, Option<&'static s
 /// Uploads one mesh (OBJ, OFF, PLY or STL); returns its content address and summary.
 #[utoipa::path(post, path = "/v1/meshes", tag = "meshes", params(FormatQuery),
     request_body(content = MeshBytes, content_type = "application/octet-stream", description = "mesh bytes, or multipart with a `file` part"),
-    responses((status = 201, description = "stored (or already stored: the id is the content's sha256)", body = MeshView), (status = 413, description = "body or mesh over the limits", body = ErrorBody), (status = 422, description = "invalid mesh", body = ErrorBody)))]
+    responses((status = 201, description = "stored (or already stored: the id is the content's sha256)", body = MeshView), (status = 413, description = "body or mesh over the limits", body = ErrorBody), (status = 429, description = "concurrent uploads hold the upload memory; see Retry-After", body = ErrorBody), (status = 422, description = "invalid mesh", body = ErrorBody)))]
 pub async fn upload_mesh(
     State(st): State<AppState>,
     Owner(owner): Owner,
     Q(q): Q<FormatQuery>,
     req: Request,
 ) -> Result<(StatusCode, Json<MeshView>), ApiError> {
+    let declared = req
+        .headers()
+        .get(axum::http::header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.parse::<usize>().ok());
+    let limit = st.service.limits.max_body_bytes;
+    let _held = st.service.limits.uploads.reserve(declared.unwrap_or(limit).min(limit))?;
     let (bytes, ext) = if is_multipart(req.headers()) {
         let mp = Multipart::from_request(req, &st)
             .await

@@ -21,6 +21,11 @@ struct Args {
     /// Directory of the content-addressed blobs (meshes, artifacts).
     #[arg(long, env = "SURFMAP_DATA_DIR", default_value = "./surfmap-data")]
     data_dir: PathBuf,
+    /// Where blobs (meshes, artifacts) live: `file:///path`, or `s3://bucket/prefix` with the
+    /// standard AWS variables (AWS_ENDPOINT_URL, AWS_ACCESS_KEY_ID, AWS_SECRET_ACCESS_KEY,
+    /// AWS_REGION, AWS_ALLOW_HTTP) [default: `blobs/` under --data-dir].
+    #[arg(long, env = "SURFMAP_BLOB_URL")]
+    blob_url: Option<String>,
     /// In-process workers [default: number of cores]; 0 serves the API only.
     #[arg(long, env = "SURFMAP_WORKERS")]
     workers: Option<usize>,
@@ -83,7 +88,7 @@ async fn run(a: Args) -> anyhow::Result<()> {
     }
     surfmap_worker::telemetry::prometheus();
     let store = surfmap_store::Store::connect(&a.database_url).await?;
-    let blobs = surfmap_store::BlobStore::open(&a.data_dir)?;
+    let blobs = surfmap_store::BlobStore::from_url(a.blob_url.as_deref(), &a.data_dir)?;
     let limits = Limits {
         max_body_bytes: a.max_body_mb.saturating_mul(1 << 20),
         max_json_bytes: a.max_json_mb.saturating_mul(1 << 20),

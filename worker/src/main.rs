@@ -15,6 +15,11 @@ struct Args {
     /// Directory of the content-addressed blobs (shared with the server).
     #[arg(long, env = "SURFMAP_DATA_DIR", default_value = "./surfmap-data")]
     data_dir: PathBuf,
+    /// Where blobs (meshes, artifacts) live: `file:///path`, or `s3://bucket/prefix` with the
+    /// standard AWS variables (AWS_ENDPOINT_URL, AWS_ACCESS_KEY_ID, AWS_SECRET_ACCESS_KEY,
+    /// AWS_REGION, AWS_ALLOW_HTTP) [default: `blobs/` under --data-dir].
+    #[arg(long, env = "SURFMAP_BLOB_URL")]
+    blob_url: Option<String>,
     /// Lease owner name [default: host-pid-random].
     #[arg(long, env = "SURFMAP_WORKER_ID")]
     worker_id: Option<String>,
@@ -63,7 +68,7 @@ async fn run(a: Args) -> anyhow::Result<()> {
         anyhow::bail!("--lease-secs must be positive");
     }
     let store = surfmap_store::Store::connect(&a.database_url).await?;
-    let blobs = surfmap_store::BlobStore::open(&a.data_dir)?;
+    let blobs = surfmap_store::BlobStore::from_url(a.blob_url.as_deref(), &a.data_dir)?;
     let config = WorkerConfig {
         id: a.worker_id.unwrap_or_else(WorkerConfig::default_id),
         lease: Duration::from_secs_f64(a.lease_secs),

@@ -79,10 +79,11 @@ impl Drop for Proc {
     }
 }
 
-fn spawn(bin: &str, args: &[String], log: PathBuf) -> Proc {
+fn spawn(bin: &str, args: &[String], log: PathBuf, vars: &[(String, String)]) -> Proc {
     let err = std::fs::File::create(&log).expect("log file");
     let mut child = Command::new(binary(bin))
         .args(args)
+        .envs(vars.iter().map(|(k, v)| (k, v)))
         .env("RUST_LOG", "info,sqlx=warn")
         .stdout(Stdio::piped())
         .stderr(err)
@@ -109,6 +110,8 @@ fn spawn(bin: &str, args: &[String], log: PathBuf) -> Proc {
 pub struct Env {
     pub dir: tempfile::TempDir,
     pub database_url: String,
+    /// Environment variables of every process started (the AWS ones for an S3 blob store).
+    pub vars: Vec<(String, String)>,
 }
 
 impl Env {
@@ -116,14 +119,14 @@ impl Env {
     pub fn sqlite() -> Env {
         let dir = tempfile::tempdir().expect("tempdir");
         let database_url = format!("sqlite://{}", dir.path().join("surfmap.db").display());
-        Env { dir, database_url }
+        Env { dir, database_url, vars: Vec::new() }
     }
 
     /// A fresh PostgreSQL database, when `SURFMAP_TEST_POSTGRES_URL` is set.
     pub async fn postgres() -> Option<Env> {
         let base = surfmap_store::testing::postgres_base_url()?;
         let database_url = surfmap_store::testing::fresh_postgres_database(&base).await.expect("create test database");
-        Some(Env { dir: tempfile::tempdir().expect("tempdir"), database_url })
+        Some(Env { dir: tempfile::tempdir().expect("tempdir"), database_url, vars: Vec::new() })
     }
 
     /// Both stores this machine offers.
@@ -134,21 +137,31 @@ impl Env {
     }
 
     fn common(&self) -> Vec<String> {
+        self.common_in("data")
+    }
+
+    /// The database and `--data-dir` `data` under the scratch directory.
+    fn common_in(&self, data: &str) -> Vec<String> {
         vec![
             "--database-url".into(),
             self.database_url.clone(),
             "--data-dir".into(),
-            self.dir.path().join("data").display().to_string(),
+            self.dir.path().join(data).display().to_string(),
         ]
     }
 
     /// Starts `surfmap-server` on 127.0.0.1:0; returns it and its base URL.
     pub fn server(&self, extra: &[&str]) -> (Proc, String) {
+        self.server_in("data", extra)
+    }
+
+    /// [`Env::server`] with its own `--data-dir`.
+    pub fn server_in(&self, data: &str, extra: &[&str]) -> (Proc, String) {
         let mut args = vec!["--listen".to_string(), "127.0.0.1:0".into()];
-        args.extend(self.common());
+        args.extend(self.common_in(data));
         args.extend(extra.iter().map(|s| s.to_string()));
         let n = std::fs::read_dir(self.dir.path()).map(|d| d.count()).unwrap_or(0);
-        let p = spawn("surfmap-server", &args, self.dir.path().join(format!("server-{n}.log")));
+        let p = spawn("surfmap-server", &args, self.dir.path().join(format!("server-{n}.log")), &self.vars);
         let addr = p
             .first_line
             .strip_prefix("listening on ")
@@ -159,10 +172,15 @@ impl Env {
 
     /// Starts a `surfmap-worker` with the given id.
     pub fn worker(&self, id: &str, extra: &[&str]) -> Proc {
-        let mut args = self.common();
+        self.worker_in("data", id, extra)
+    }
+
+    /// [`Env::worker`] with its own `--data-dir`.
+    pub fn worker_in(&self, data: &str, id: &str, extra: &[&str]) -> Proc {
+        let mut args = self.common_in(data);
         args.extend(["--worker-id".to_string(), id.to_string(), "--poll-ms".into(), "100".into()]);
         args.extend(extra.iter().map(|s| s.to_string()));
-        let p = spawn("surfmap-worker", &args, self.dir.path().join(format!("worker-{id}.log")));
+        let p = spawn("surfmap-worker", &args, self.dir.path().join(format!("worker-{id}.log")), &self.vars);
         assert!(p.first_line.contains("ready"), "worker did not start: {:?}\n{}", p.first_line, p.log_text());
         p
     }

@@ -176,12 +176,12 @@ fn bad_quad_jobs_get_typed_errors() {
         (
             json!({"method": "quad", "anchors": rows(4), "options": {"level": 11}}),
             vec![s.clone(), s.clone()],
-            "invalid_spec",
+            "option_out_of_range",
         ),
         (
             json!({"method": "quad", "anchors": rows(4), "options": {"adaptive_epsilon": -1.0}}),
             vec![s.clone(), s.clone()],
-            "invalid_spec",
+            "option_out_of_range",
         ),
     ];
     for (v, meshes, code) in cases {

@@ -2,7 +2,7 @@
 //! from the same `ApiError`s, `WatchJob` as a server stream and artifacts in 64 KiB chunks.
 
 use crate::AppState;
-use crate::service::{job_filter, parse_spec};
+use crate::service::job_filter;
 use futures::{Stream, StreamExt};
 use std::pin::Pin;
 use surfmap_proto::v1 as pb;
@@ -79,10 +79,9 @@ impl Surfmap for GrpcApi {
             ))
             .into());
         }
-        let spec = parse_spec(r.spec_json.as_bytes())?;
         let key = Some(r.idempotency_key).filter(|k| !k.is_empty());
         let meshes = if r.meshes.is_empty() { vec![r.source, r.target] } else { r.meshes };
-        let (j, _) = self.state.service.submit(&o, &meshes, &spec, key).await?;
+        let (j, _) = self.state.service.submit(&o, &meshes, r.spec_json.as_bytes(), key).await?;
         Ok(Response::new(job(&j)))
     }
 

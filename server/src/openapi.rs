@@ -2,7 +2,7 @@
 
 use crate::error::ErrorBody;
 use crate::rest::{artifacts, jobs, meshes, ops};
-use crate::views::{ArtifactList, ArtifactView, JobLinks, JobPage, JobView, MeshView, SubmitJob};
+use crate::views::{ArtifactList, ArtifactView, JobLinks, JobPage, JobView, MeshView, SpecOutline, SubmitJob};
 
 #[derive(utoipa::OpenApi)]
 #[openapi(
@@ -24,6 +24,16 @@ use crate::views::{ArtifactList, ArtifactView, JobLinks, JobPage, JobView, MeshV
         ops::metrics,
         ops::openapi
     ),
-    components(schemas(ErrorBody, MeshView, JobView, JobLinks, JobPage, ArtifactView, ArtifactList, SubmitJob))
+    components(schemas(
+        ErrorBody,
+        MeshView,
+        JobView,
+        JobLinks,
+        JobPage,
+        ArtifactView,
+        ArtifactList,
+        SubmitJob,
+        SpecOutline
+    ))
 )]
 pub struct ApiDoc;

@@ -112,6 +112,15 @@ pub fn format_hint(file_name: Option<&str>) -> Option<&'static str> {
 /// # Errors
 /// 400 `invalid_query` for an unknown state.
 pub fn job_filter(state: &str, method: &str, cursor: &str, limit: i64) -> Result<JobFilter, ApiError> {
+    if !(1..=500).contains(&limit) && limit != 0 {
+        return Err(ApiError::bad_request("invalid_query", format!("limit {limit} is outside 1..=500")));
+    }
+    if !method.is_empty() && !METHODS.contains(&method) {
+        return Err(ApiError::bad_request(
+            "invalid_query",
+            format!("unknown method {method:?}; available: {}", METHODS.join(", ")),
+        ));
+    }
     let state = match state {
         "" => None,
         s => Some(
@@ -192,13 +201,13 @@ impl JobService {
     /// `[source, target]`; `quad` jobs take 1 to 16 meshes.
     ///
     /// # Errors
-    /// 400 bad spec or unknown method; 404 unknown mesh; 422 genus mismatch, bad anchors;
+    /// 404 unknown mesh; 400 bad spec or unknown method; 422 genus mismatch, bad anchors;
     /// 409 idempotency key reused for another request.
     pub async fn submit(
         &self,
         owner: &str,
         meshes: &[String],
-        job: &Job,
+        spec: &[u8],
         idempotency_key: Option<String>,
     ) -> Result<(JobRecord, bool), ApiError> {
         if meshes.is_empty() || meshes.len() > geom::pipeline::MAX_MODELS {
@@ -216,6 +225,8 @@ impl JobService {
             };
             summaries.push(self.summary(owner, &role, id).await?);
         }
+        // The meshes first (404), then the spec: parsed once, here, into the typed job.
+        let job = &parse_spec(spec)?;
         job.check(&summaries)?;
         let estimate = job.memory_estimate(&summaries);
         if estimate > self.limits.job_memory_bytes {
@@ -283,7 +294,11 @@ impl JobService {
     /// # Errors
     /// 400 `invalid_artifact_name`; 404 unknown job or artifact.
     pub async fn artifact(&self, owner: &str, id: &str, name: &str) -> Result<(ArtifactRef, Vec<u8>), ApiError> {
-        if name.is_empty() || name.contains(['/', '\\', '\0']) || name.contains("..") {
+        // Dot-separated runs of [A-Za-z0-9_-] (the OpenAPI pattern of `name`): no path, no `..`.
+        let plain = name
+            .split('.')
+            .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-'));
+        if !plain {
             return Err(ApiError::bad_request(
                 "invalid_artifact_name",
                 format!("artifact name {name:?} is not a plain file name"),

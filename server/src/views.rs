@@ -93,11 +93,30 @@ pub struct SubmitJob {
     /// Mesh ids of an N-mesh job (`quad`), in the order of the spec's anchor columns; instead
     /// of `source` and `target`.
     #[serde(default)]
+    #[schema(min_items = 1, max_items = 16)]
     pub meshes: Option<Vec<String>>,
     /// Exactly the spec `surfmap map --spec` (or `surfmap remesh --spec`) takes:
     /// `{"method", "anchors", "options"}`.
-    #[schema(value_type = Object)]
+    #[schema(value_type = SpecOutline)]
     pub spec: serde_json::Value,
+}
+
+/// The outline of a job spec as the document describes it; the full form (every option and
+/// its range) is in the README. Checked against the meshes after they are found.
+#[derive(Debug, ToSchema)]
+#[allow(dead_code)]
+pub struct SpecOutline {
+    /// voronoi | greedy | homology | quad
+    #[schema(pattern = "^(voronoi|greedy|homology|quad)$")]
+    method: String,
+    /// Vertex-id rows: `[source, target]` for pair jobs, one id per mesh for `quad`.
+    anchors: Vec<Vec<u64>>,
+    /// `homology`: corresponding feature curves.
+    #[schema(value_type = Option<Vec<Object>>)]
+    features: Option<Vec<serde_json::Value>>,
+    /// The method's options (README).
+    #[schema(value_type = Option<Object>)]
+    options: Option<serde_json::Value>,
 }
 
 pub fn artifact_view(job: &str, a: &ArtifactRef) -> ArtifactView {

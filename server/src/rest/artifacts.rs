@@ -23,7 +23,7 @@ pub async fn list_artifacts(
 
 /// One artifact's bytes.
 #[utoipa::path(get, path = "/v1/jobs/{id}/artifacts/{name}", tag = "artifacts",
-    params(("id" = String, Path), ("name" = String, Path)),
+    params(("id" = String, Path), ("name" = String, Path, pattern = r"^[A-Za-z0-9_-]+(\.[A-Za-z0-9_-]+)*$", description = "an artifact's file name")),
     responses((status = 200, description = "the file, with its content type"),
         (status = 400, description = "a name with a path in it", body = ErrorBody), (status = 404, description = "unknown job or artifact", body = ErrorBody)))]
 pub async fn get_artifact(

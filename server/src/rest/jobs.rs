@@ -3,7 +3,7 @@
 use super::{Owner, P, Q, is_multipart, multipart_error, read_limited};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
-use crate::service::{format_hint, job_filter, parse_spec};
+use crate::service::{format_hint, job_filter};
 use crate::views::{JobPage, JobView, SubmitJob, job_view};
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
@@ -19,11 +19,15 @@ use surfmap_store::BlobStore;
 #[into_params(parameter_in = Query)]
 pub struct ListQuery {
     /// queued | running | succeeded | failed | cancelled
+    #[param(pattern = "^(queued|running|succeeded|failed|cancelled)$")]
     pub state: Option<String>,
+    /// voronoi | greedy | homology | quad
+    #[param(pattern = "^(voronoi|greedy|homology|quad)$")]
     pub method: Option<String>,
     /// `next_cursor` of the previous page.
     pub cursor: Option<String>,
     /// 1 to 500; 50 by default.
+    #[param(minimum = 1, maximum = 500)]
     pub limit: Option<i64>,
 }
 
@@ -113,7 +117,6 @@ pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Re
         };
         (meshes, serde_json::to_vec(&s.spec).map_err(ApiError::internal)?)
     };
-    let spec = parse_spec(&spec)?;
     let (job, created) = st.service.submit(&owner, &meshes, &spec, key).await?;
     let mut headers = HeaderMap::new();
     if let Ok(v) = HeaderValue::from_str(&format!("/v1/jobs/{}", job.id)) {
@@ -143,11 +146,18 @@ pub async fn list_jobs(
     Owner(owner): Owner,
     Q(q): Q<ListQuery>,
 ) -> Result<Json<JobPage>, ApiError> {
+    if q.state.as_deref() == Some("") || q.method.as_deref() == Some("") {
+        return Err(ApiError::bad_request("invalid_query", "state and method, when given, must not be empty"));
+    }
     let filter = job_filter(
         q.state.as_deref().unwrap_or_default(),
         q.method.as_deref().unwrap_or_default(),
         q.cursor.as_deref().unwrap_or_default(),
-        q.limit.unwrap_or(50),
+        match q.limit {
+            None => 50,
+            Some(l @ 1..=500) => l,
+            Some(l) => return Err(ApiError::bad_request("invalid_query", format!("limit {l} is outside 1..=500"))),
+        },
     )?;
     let (jobs, next_cursor) = st.service.list(&owner, filter).await?;
     Ok(Json(JobPage { jobs: jobs.iter().map(job_view).collect(), next_cursor }))

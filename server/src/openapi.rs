@@ -2,7 +2,10 @@
 
 use crate::error::ErrorBody;
 use crate::rest::{artifacts, jobs, meshes, ops};
-use crate::views::{ArtifactList, ArtifactView, JobLinks, JobPage, JobView, MeshView, SpecOutline, SubmitJob};
+use crate::views::{
+    ArtifactList, ArtifactView, JobLinks, JobPage, JobView, MeshView, MeshesJobRequest, PairJobRequest, SpecOutline,
+    SubmitJobRequest,
+};
 
 #[derive(utoipa::OpenApi)]
 #[openapi(
@@ -32,7 +35,9 @@ use crate::views::{ArtifactList, ArtifactView, JobLinks, JobPage, JobView, MeshV
         JobPage,
         ArtifactView,
         ArtifactList,
-        SubmitJob,
+        SubmitJobRequest,
+        PairJobRequest,
+        MeshesJobRequest,
         SpecOutline
     ))
 )]

@@ -101,6 +101,40 @@ pub struct SubmitJob {
     pub spec: serde_json::Value,
 }
 
+/// `POST /v1/jobs` as the document describes it: a pair job or an N-mesh job (the handler
+/// reads [`SubmitJob`] and names the missing or extra field).
+#[derive(Debug, Deserialize, ToSchema)]
+#[serde(untagged)]
+#[allow(dead_code)]
+pub enum SubmitJobRequest {
+    Pair(PairJobRequest),
+    Meshes(MeshesJobRequest),
+}
+
+/// A pair job (`voronoi`, `greedy`, `homology`).
+#[derive(Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)]
+pub struct PairJobRequest {
+    /// Mesh id (sha256) from `POST /v1/meshes`.
+    source: String,
+    target: String,
+    #[schema(value_type = SpecOutline)]
+    spec: serde_json::Value,
+}
+
+/// An N-mesh job (`quad`).
+#[derive(Debug, Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)]
+pub struct MeshesJobRequest {
+    /// Mesh ids in the order of the spec's anchor columns.
+    #[schema(min_items = 1, max_items = 16)]
+    meshes: Vec<String>,
+    #[schema(value_type = SpecOutline)]
+    spec: serde_json::Value,
+}
+
 /// The outline of a job spec as the document describes it; the full form (every option and
 /// its range) is in the README. Checked against the meshes after they are found.
 #[derive(Debug, ToSchema)]

@@ -4,7 +4,7 @@ use super::{Owner, P, Q, is_multipart, multipart_error, read_limited};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
 use crate::service::{format_hint, job_filter};
-use crate::views::{JobPage, JobView, SubmitJob, job_view};
+use crate::views::{JobPage, JobView, SubmitJob, SubmitJobRequest, job_view};
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
 use axum::http::{HeaderMap, HeaderValue, StatusCode, header};
@@ -72,7 +72,7 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
 }
 
 /// Validates a job against its meshes and queues it.
-#[utoipa::path(post, path = "/v1/jobs", tag = "jobs", request_body = SubmitJob,
+#[utoipa::path(post, path = "/v1/jobs", tag = "jobs", request_body = SubmitJobRequest,
     params(("Idempotency-Key" = Option<String>, Header, description = "retries with the same key return the same job")),
     responses((status = 202, description = "queued (or the job an earlier request with this Idempotency-Key made)", body = JobView, headers(("Location" = String, description = "the job's URL"))),
         (status = 400, description = "bad spec or unknown method", body = ErrorBody),

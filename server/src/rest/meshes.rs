@@ -14,6 +14,7 @@ use axum::http::StatusCode;
 #[into_params(parameter_in = Query)]
 pub struct FormatQuery {
     /// obj, off, ply or stl; only used when the content does not tell.
+    #[param(pattern = "^(obj|off|ply|stl)$")]
     pub format: Option<String>,
 }
 
@@ -37,7 +38,7 @@ pub async fn first_file(mut mp: Multipart) -> Result<(Vec<u8>, Option<&'static s
 /// Uploads one mesh (OBJ, OFF, PLY or STL); returns its content address and summary.
 #[utoipa::path(post, path = "/v1/meshes", tag = "meshes", params(FormatQuery),
     request_body(content = MeshBytes, content_type = "application/octet-stream", description = "mesh bytes, or multipart with a `file` part"),
-    responses((status = 201, description = "stored (or already stored: the id is the content's sha256)", body = MeshView), (status = 413, description = "body or mesh over the limits", body = ErrorBody), (status = 429, description = "concurrent uploads hold the upload memory; see Retry-After", body = ErrorBody), (status = 422, description = "invalid mesh", body = ErrorBody)))]
+    responses((status = 400, description = "an unknown `format`", body = ErrorBody), (status = 201, description = "stored (or already stored: the id is the content's sha256)", body = MeshView), (status = 413, description = "body or mesh over the limits", body = ErrorBody), (status = 429, description = "concurrent uploads hold the upload memory; see Retry-After", body = ErrorBody), (status = 422, description = "invalid mesh", body = ErrorBody)))]
 pub async fn upload_mesh(
     State(st): State<AppState>,
     Owner(owner): Owner,
@@ -60,6 +61,9 @@ pub async fn upload_mesh(
         let (parts, body) = req.into_parts();
         (read_limited(&parts.headers, body, st.service.limits.max_body_bytes).await?.to_vec(), None)
     };
+    if let Some(f) = q.format.as_deref().filter(|f| !["obj", "off", "ply", "stl"].contains(f)) {
+        return Err(ApiError::bad_request("unknown_format", format!("format {f:?} is not obj, off, ply or stl")));
+    }
     let hint = q.format.as_deref().or(ext);
     let view = st.service.upload_mesh(&owner, bytes, hint).await?;
     Ok((StatusCode::CREATED, Json(view)))

@@ -309,14 +309,17 @@ fn reembed(
 /// Re-embeds regions around faces the evaluator counts as folded; `fixed` images never move,
 /// nor do the source's boundary vertices.
 ///
+/// Polls `stop` before each region it re-embeds.
+///
 /// # Errors
-/// `Error::Internal` if the target's index cannot be built.
+/// `Error::Internal` if the target's index cannot be built; `Error::Cancelled` when `stop` is.
 pub fn untangle(
     source: &Mesh,
     target: &Mesh,
     map: &mut SurfaceMap,
     fixed: &[VertexId],
     opts: &UntangleOptions,
+    stop: &dyn crate::progress::Progress,
 ) -> Result<UntangleResult> {
     if opts.max_attempts == 0 {
         return Ok(UntangleResult::default());
@@ -373,6 +376,7 @@ pub fn untangle(
             }
             let mut fixed_here = false;
             for rings in (2..=opts.max_rings).step_by(2) {
+                stop.check()?;
                 if attempts >= opts.max_attempts {
                     break;
                 }
@@ -465,7 +469,8 @@ mod tests {
             .collect();
         let mut map = SurfaceMap::from_positions(&pos, &s, None).unwrap();
         let anchor_at = map.position(anchor, &s);
-        let r = untangle(&s, &s, &mut map, &[anchor], &UntangleOptions::default()).unwrap();
+        let r =
+            untangle(&s, &s, &mut map, &[anchor], &UntangleOptions::default(), &crate::progress::NoProgress).unwrap();
         assert!(r.folded_before > 3, "{r:?}");
         assert_eq!(r.folded_after, 0, "{r:?}");
         assert!(r.regions >= 1);

@@ -126,9 +126,13 @@ fn relax_with(
 ) -> Result<(SurfaceMap, smooth::SmoothReport)> {
     let (mut m, r) = smooth::smooth(from, to, map, fixed, so, progress)?;
     let newton = crate::crossparam::newton::relax_newton(from, to, &mut m, fixed, &o.newton, progress)?;
+    progress.check()?;
     let mut v = crate::crossparam::visible::make_visible(from, to, &mut m, fixed, true)?;
+    progress.check()?;
     let mut repaired = crate::crossparam::visible::repair_flips(from, to, &mut m, fixed, false)?;
-    let untangled = crate::crossparam::untangle::untangle(from, to, &mut m, fixed, &o.untangle)?;
+    progress.check()?;
+    let untangled = crate::crossparam::untangle::untangle(from, to, &mut m, fixed, &o.untangle, progress)?;
+    progress.check()?;
     repaired += crate::crossparam::slide::slide_boundary(from, to, &mut m, fixed)?;
     // Repairs, re-embedding and sliding place images anew; any of them can land on a hidden spot.
     if repaired > 0 || untangled.regions > 0 {
@@ -455,5 +459,52 @@ mod tests {
         };
         let msg = e.to_string();
         assert!(msg.contains("anchors [0, 1, 2, 3, 4, 5, 6, 7]") && msg.contains("not disks"), "{msg}");
+    }
+}
+
+#[cfg(test)]
+mod cancel_tests {
+    use super::*;
+    use crate::mesh::shapes;
+    use crate::pipeline::MapOptions;
+    use crate::progress::CancelToken;
+
+    /// Cancels its token when a stage starts and records every stage reported.
+    struct CancelAt {
+        stage: &'static str,
+        token: CancelToken,
+        seen: Vec<String>,
+    }
+
+    impl Progress for CancelAt {
+        fn report(&mut self, stage: &str, _fraction: f64) {
+            if stage == self.stage {
+                self.token.cancel();
+            }
+            self.seen.push(stage.to_string());
+        }
+        fn cancelled(&self) -> bool {
+            self.token.is_cancelled()
+        }
+        fn token(&self) -> Option<CancelToken> {
+            Some(self.token.clone())
+        }
+    }
+
+    /// A cancel inside the smoothing stage ends the job with `Cancelled` before any later stage
+    /// (both halves of the parallel split see it: the side half through `Progress::silent`).
+    #[test]
+    fn a_cancel_inside_a_stage_stops_the_job_there() {
+        let s = shapes::icosphere(3);
+        let t =
+            s.with_positions(s.positions().iter().map(|p| crate::mesh::P3::new(p.x * 1.4, p.y, p.z * 0.8)).collect());
+        let t = t.unwrap();
+        let anchors: Vec<[u64; 2]> = [0u64, 5, 9, 13, 21, 40].iter().map(|&i| [i, i]).collect();
+        let spec = JobSpec { method: Method::Voronoi, anchors, features: Vec::new(), options: MapOptions::default() };
+        let mut p = CancelAt { stage: "smooth", token: CancelToken::default(), seen: Vec::new() };
+        let r = run_map(&spec, &s, &t, &mut p);
+        assert!(matches!(r, Err(Error::Cancelled)), "{:?}", r.err());
+        assert!(p.seen.iter().any(|s| s == "smooth"), "{:?}", p.seen);
+        assert!(!p.seen.iter().any(|s| s == "metrics" || s == "done"), "ran on after the cancel: {:?}", p.seen);
     }
 }

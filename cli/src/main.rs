@@ -91,6 +91,14 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // The pipeline's diagnostics are `tracing` events at debug level: `RUST_LOG=geom=debug`
+    // prints them on stderr.
+    if std::env::var_os("RUST_LOG").is_some() {
+        tracing_subscriber::fmt()
+            .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+            .with_writer(std::io::stderr)
+            .init();
+    }
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

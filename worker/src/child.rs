@@ -68,6 +68,14 @@ pub fn main_if_child() -> Option<std::process::ExitCode> {
         eprintln!("{CHILD_ARG} needs the job directory");
         return Some(std::process::ExitCode::from(2));
     };
+    // `geom`'s debug events (`RUST_LOG=geom=debug`) go to the inherited stderr, the worker's log.
+    if std::env::var_os("RUST_LOG").is_some() {
+        tracing_subscriber::fmt()
+            .with_env_filter(tracing_subscriber::EnvFilter::from_default_env())
+            .with_writer(std::io::stderr)
+            .with_ansi(false)
+            .init();
+    }
     // The parent holds our stdin; when it goes away, so do we.
     std::thread::spawn(|| {
         let mut sink = [0u8; 64];

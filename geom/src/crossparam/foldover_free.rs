@@ -257,8 +257,8 @@ pub fn foldover_free(
         let e = prob.eval(&x, None);
         let sigma = (1.0 - e / e_prev).max(0.1);
         let md = prob.min_det(&x);
-        if std::env::var_os("SURFMAP_DEBUG").is_some() {
-            eprintln!(
+        if tracing::enabled!(tracing::Level::DEBUG) {
+            tracing::debug!(
                 "foldover_free: round {round} eps {:.2e} energy {e_prev:.4e} -> {e:.4e} min det {md:.3e}",
                 prob.eps
             );

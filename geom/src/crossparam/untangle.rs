@@ -165,7 +165,7 @@ fn fill_holes(mesh: &Mesh, faces: &[FaceId]) -> Vec<FaceId> {
     out
 }
 
-/// For `SURFMAP_DEBUG`: how tangled the current images of a region are in its chart.
+/// For debug-level tracing: how tangled the current images of a region are in its chart.
 fn chart_state(rmesh: &Mesh, rb: &[VertexId], uv: &[Uv], held: &[bool], sign: f64) -> String {
     let inv = |f: usize| signed_area(rmesh.face(FaceId::from_idx(f)).map(|v| uv[v.idx()])) * sign <= 0.0;
     let all_held = |f: usize| rmesh.face(FaceId::from_idx(f)).iter().all(|v| held[v.idx()]);
@@ -195,8 +195,8 @@ fn reembed(
     chart_rings: usize,
 ) -> Vec<Moves> {
     let why = |m: &str| {
-        if std::env::var_os("SURFMAP_DEBUG").is_some() {
-            eprintln!("untangle:   {} faces: {m}", faces.len());
+        if tracing::enabled!(tracing::Level::DEBUG) {
+            tracing::debug!("untangle:   {} faces: {m}", faces.len());
         }
     };
     let Some((rmesh, rparent)) = disk_of(source, faces) else {
@@ -243,7 +243,7 @@ fn reembed(
         why("image outside the chart");
         return Vec::new();
     };
-    if std::env::var_os("SURFMAP_DEBUG").is_some() {
+    if tracing::enabled!(tracing::Level::DEBUG) {
         why(&chart_state(&rmesh, &rb, &current, &is_held, sign));
     }
     let held_vs: Vec<VertexId> = (0..rmesh.n_vertices()).map(VertexId::from_idx).filter(|v| is_held[v.idx()]).collect();
@@ -401,8 +401,8 @@ pub fn untangle(
                         best = Some(Candidate { folds: after, energy: e, pos: p2, near: n2, moves: moved });
                     }
                 }
-                if std::env::var_os("SURFMAP_DEBUG").is_some() {
-                    eprintln!(
+                if tracing::enabled!(tracing::Level::DEBUG) {
+                    tracing::debug!(
                         "untangle: seed {} rings {rings}: {} faces, {nc} candidates, folds {before} -> {afters:?}",
                         f.0,
                         region.len()

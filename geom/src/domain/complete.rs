@@ -48,9 +48,9 @@ fn try_link(ts: &mut [&mut Tracer], ends: [(usize, usize); 2], stats: &mut Compl
         match t.trace(&req)? {
             Some(p) => found.push(p),
             None => {
-                if std::env::var_os("SURFMAP_DEBUG").is_some() {
+                if tracing::enabled!(tracing::Level::DEBUG) {
                     let free = t.trace(&TraceRequest { a, b, ..Default::default() })?.is_some();
-                    eprintln!(
+                    tracing::debug!(
                         "link {a}-{b} failed; sectors {:?} {:?}; unconstrained ok: {free}; rot a {:?} rot b {:?}",
                         req.sector_a,
                         req.sector_b,
@@ -96,11 +96,11 @@ fn excess(t: &Tracer, ws: &[super::walks::Walk], chi: i64) -> i64 {
     t.anchors().len() as i64 - t.paths().len() as i64 + ws.len() as i64 - chi
 }
 
-/// For `SURFMAP_DEBUG`: the layout's census before each completion step, [`excess`] and the
+/// For debug-level tracing: the layout's census before each completion step, [`excess`] and the
 /// open walks (the regions still to split).
 fn census(t: &Tracer, ws: &[super::walks::Walk], chi: i64) {
     let open: Vec<Vec<u32>> = ws.iter().filter(|w| !w.is_triangle(t)).map(|w| w.corners(t)).collect();
-    eprintln!(
+    tracing::debug!(
         "complete: V {} E {} W {} (V - E + W - chi = {}) open walks {open:?}",
         t.anchors().len(),
         t.paths().len(),
@@ -176,7 +176,7 @@ pub fn complete(
             .into());
         }
         let ws = walks(t0);
-        if std::env::var_os("SURFMAP_DEBUG").is_some() {
+        if tracing::enabled!(tracing::Level::DEBUG) {
             census(t0, &ws, chi);
         }
         // 1. Split non-triangular walks by their shortest admissible diagonal.

@@ -196,8 +196,8 @@ pub fn flip_paths(
                 (false, false) => f64::INFINITY,
             };
             let too_long = |mesh: &str, new: f64, old: f64| {
-                if waived && std::env::var_os("SURFMAP_DEBUG").is_some() {
-                    eprintln!("flip valence-two: {mesh} growth {:.3}", new / old);
+                if waived && tracing::enabled!(tracing::Level::DEBUG) {
+                    tracing::debug!("flip valence-two: {mesh} growth {:.3}", new / old);
                 }
                 new >= growth * old
             };

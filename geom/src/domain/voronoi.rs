@@ -96,10 +96,10 @@ pub fn source_layout(
             None => stats.failed_traces += 1,
         }
     }
-    if std::env::var_os("SURFMAP_DEBUG").is_some() {
-        eprintln!("source cuts {} paths {} failed {}", cl.cuts.len(), t.paths().len(), stats.failed_traces);
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!("source cuts {} paths {} failed {}", cl.cuts.len(), t.paths().len(), stats.failed_traces);
         for c in &cl.cuts {
-            eprintln!("  cut {}-{} edges {}", c.i, c.j, c.edges.len());
+            tracing::debug!("  cut {}-{} edges {}", c.i, c.j, c.edges.len());
         }
     }
     link_isolated(t, &mut stats)?;
@@ -297,7 +297,7 @@ pub fn target_layout(
                 continue;
             }
             let s = postponed[0];
-            if std::env::var_os("SURFMAP_DEBUG").is_some() {
+            if tracing::enabled!(tracing::Level::DEBUG) {
                 for &s in &postponed {
                     let p = &src.paths()[s];
                     let free = tgt.trace(&TraceRequest { a: p.a, b: p.b, ..Default::default() })?.is_some();
@@ -307,7 +307,7 @@ pub fn target_layout(
                         tgt.trace(&TraceRequest { a: p.a, b: p.b, sector_a: sa, ..Default::default() })?.is_some();
                     let only_b =
                         tgt.trace(&TraceRequest { a: p.a, b: p.b, sector_b: sb, ..Default::default() })?.is_some();
-                    eprintln!(
+                    tracing::debug!(
                         "target path {s} {}-{} group {} free {free} only_a {only_a} only_b {only_b} placed {}/{np}",
                         p.a,
                         p.b,
@@ -316,7 +316,7 @@ pub fn target_layout(
                     );
                     for w in walks(tgt) {
                         if !w.is_triangle(tgt) {
-                            eprintln!("  open walk {:?} halves {:?}", w.corners(tgt), w.halves);
+                            tracing::debug!("  open walk {:?} halves {:?}", w.corners(tgt), w.halves);
                         }
                     }
                 }

@@ -567,10 +567,10 @@ fn finish(
     Ok((basis, curves))
 }
 
-/// Prints what `msg` says under `SURFMAP_DEBUG` (built only then).
+/// Prints what `msg` says under debug-level tracing (built only then).
 fn debug(msg: impl FnOnce() -> String) {
-    if std::env::var_os("SURFMAP_DEBUG").is_some() {
-        eprintln!("homology basis: {}", msg());
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!("homology basis: {}", msg());
     }
 }
 

@@ -345,7 +345,7 @@ fn shortest_simple_loop(
     }
     cands.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
     let mut mark = vec![false; mesh.n_vertices()];
-    let dbg = std::env::var_os("SURFMAP_DEBUG").is_some();
+    let dbg = tracing::enabled!(tracing::Level::DEBUG);
     let (mut n_touch, mut n_room) = (0, 0);
     let nc = cands.len();
     for (_, lx, ly) in cands {
@@ -373,7 +373,7 @@ fn shortest_simple_loop(
     }
     if dbg {
         let both = two.of.iter().filter(|o| o.len() == 2).count();
-        eprintln!(
+        tracing::debug!(
             "homology basis: {nc} loop candidates, {n_touch} touching, {n_room} without room, {both} labelled twice"
         );
     }

@@ -118,8 +118,8 @@ pub fn minimize_stretch(
     let (l2_before, mut sigma) = stretch(mesh, &uv);
     let mut best = StretchResult { uv, l2_before, l2_after: l2_before, rounds: 0, residual: 0.0 };
     let mut w = weights.clone();
-    if std::env::var_os("SURFMAP_DEBUG").is_some() {
-        eprintln!("stretch: start l2 {l2_before}, sigma max {}", sigma.iter().fold(0.0f64, |a, b| a.max(*b)));
+    if tracing::enabled!(tracing::Level::DEBUG) {
+        tracing::debug!("stretch: start l2 {l2_before}, sigma max {}", sigma.iter().fold(0.0f64, |a, b| a.max(*b)));
     }
     for _ in 0..opts.iterations {
         if !best.l2_after.is_finite() || sigma.iter().any(|s| !s.is_finite() || *s <= 0.0) {
@@ -134,8 +134,8 @@ pub fn minimize_stretch(
         let fac = sys.factor_weights(&w, false)?;
         let (next, residual) = fac.solve_with_residual::<2>(fixed)?;
         let (l2, s) = stretch(mesh, &next);
-        if std::env::var_os("SURFMAP_DEBUG").is_some() {
-            eprintln!("stretch: {} vertices, l2 {} -> {l2}", mesh.n_vertices(), best.l2_after);
+        if tracing::enabled!(tracing::Level::DEBUG) {
+            tracing::debug!("stretch: {} vertices, l2 {} -> {l2}", mesh.n_vertices(), best.l2_after);
         }
         let gained = l2 < best.l2_after * (1.0 - opts.min_gain);
         if !gained {

@@ -287,16 +287,16 @@ pub fn run_map(
             Err(Error::Input(InputError::LayoutConflict(m)))
                 if attempt >= o.layout.rebuilds && method == Method::Voronoi && o.layout.greedy_fallback =>
             {
-                if std::env::var_os("SURFMAP_DEBUG").is_some() {
-                    eprintln!("greedy fallback after ({:.0} ms): {m}", clock.0.elapsed().as_secs_f64() * 1e3);
+                if tracing::enabled!(tracing::Level::DEBUG) {
+                    tracing::debug!("greedy fallback after ({:.0} ms): {m}", clock.0.elapsed().as_secs_f64() * 1e3);
                 }
                 method = Method::Greedy;
                 edge_nodes = o.layout.edge_nodes;
                 attempt = 0;
             }
             Err(Error::Input(InputError::LayoutConflict(m))) if attempt < o.layout.rebuilds => {
-                if std::env::var_os("SURFMAP_DEBUG").is_some() {
-                    eprintln!("rebuild after ({:.0} ms): {m}", clock.0.elapsed().as_secs_f64() * 1e3);
+                if tracing::enabled!(tracing::Level::DEBUG) {
+                    tracing::debug!("rebuild after ({:.0} ms): {m}", clock.0.elapsed().as_secs_f64() * 1e3);
                 }
                 // Rebuild schedule: without the denser anchor rings, then with them again and
                 // twice (minus one) the nodes per edge, then without, and so on.

@@ -125,20 +125,20 @@ fn fix_sides(
     for _ in 0..2 * features.len() + 1 {
         let left = super::sides::left_faces(mesh, &curves)?;
         let wrong = features.iter().zip(want).find(|&(&f, &p)| super::sides::vertex_left(mesh, &left, f) != (p == 0));
-        if std::env::var_os("SURFMAP_DEBUG").is_some() {
+        if tracing::enabled!(tracing::Level::DEBUG) {
             let n = features
                 .iter()
                 .zip(want)
                 .filter(|&(&f, &p)| super::sides::vertex_left(mesh, &left, f) != (p == 0))
                 .count();
-            eprintln!("features on the wrong side: {n}");
+            tracing::debug!("features on the wrong side: {n}");
         }
         let Some((&f, _)) = wrong else { return Ok(Some(curves)) };
         match super::sides::reroute(mesh, &curves, f, features)? {
             Some(c) => curves = c,
             None => {
-                if std::env::var_os("SURFMAP_DEBUG").is_some() {
-                    eprintln!("feature at vertex {} cannot be brought to its side", f.0);
+                if tracing::enabled!(tracing::Level::DEBUG) {
+                    tracing::debug!("feature at vertex {} cannot be brought to its side", f.0);
                 }
                 return Ok(None);
             }

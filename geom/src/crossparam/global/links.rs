@@ -25,7 +25,7 @@ pub fn from_refinement(
     st: &State,
     rows: &Rows,
 ) -> Vec<Option<Affine>> {
-    let dbg = std::env::var_os("SURFMAP_DEBUG").is_some();
+    let dbg = tracing::enabled!(tracing::Level::DEBUG);
     // Which path each refined edge runs on.
     let mut on_path: HashMap<(u32, u32), u32> = HashMap::new();
     for (p, vs) in r.path_vertices.iter().enumerate() {
@@ -70,7 +70,7 @@ pub fn from_refinement(
                     let (u, w) = (r.mesh.tail(h).0, r.mesh.head(h).0);
                     let Some(&path) = on_path.get(&(u.min(w), u.max(w))) else {
                         if dbg {
-                            eprintln!("links: face {f}: edge {u}-{w} between patches {pc} {pd} on no path");
+                            tracing::debug!("links: face {f}: edge {u}-{w} between patches {pc} {pd} on no path");
                         }
                         return None;
                     };
@@ -78,7 +78,7 @@ pub fn from_refinement(
                         .find(|&s| patches[pc as usize].sides[s] / 2 == path && charts.across[pc as usize][s].0 == pd)
                     else {
                         if dbg {
-                            eprintln!(
+                            tracing::debug!(
                                 "links: face {f}: path {path} is no side of {pc} towards {pd}: {:?}",
                                 patches[pc as usize]
                             );
@@ -111,7 +111,7 @@ pub fn from_refinement(
                     });
                     let Some(side) = side else {
                         if dbg {
-                            eprintln!(
+                            tracing::debug!(
                                 "links: face {f}: vertex {} in patch {} but its piece is in {pc}",
                                 v.0,
                                 st.patch[v.idx()]

@@ -130,13 +130,16 @@ pub fn global_param(
         st.link = links::from_refinement(mesh, r, patches, &charts, &st, &rows);
     }
     st.fill_links(&charts, &rows);
-    let debug = std::env::var_os("SURFMAP_DEBUG").is_some();
+    let debug = tracing::enabled!(tracing::Level::DEBUG);
     let mut system = solve::System::new(&fixed);
     let residual = relax(&charts, &mut system, &mut st, &fixed, &rows, opts.max_solves)?;
     progress.check()?;
     let l2 = vertex_stretch(mesh, &st, &rows, &fixed);
     if debug {
-        eprintln!("global: harmonic map: folds {} l2 {l2} residual {residual:.2e}", flipped(mesh, &st, &rows, &fixed));
+        tracing::debug!(
+            "global: harmonic map: folds {} l2 {l2} residual {residual:.2e}",
+            flipped(mesh, &st, &rows, &fixed)
+        );
     }
     let flipped = flipped(mesh, &st, &rows, &fixed);
     let locators = locate::locators(mesh, &charts, &st, &rows, &fixed);

@@ -117,7 +117,7 @@ struct StderrProgress {
 }
 
 impl geom::progress::Progress for StderrProgress {
-    fn report(&mut self, stage: &str, fraction: f64) {
+    fn report(&mut self, stage: geom::progress::Stage, fraction: f64) {
         if !self.tty {
             return;
         }

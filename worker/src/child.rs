@@ -16,6 +16,7 @@
 use geom::io::ReadOptions;
 use geom::mesh::MeshLimits;
 use geom::pipeline::Job;
+use geom::progress::Stage;
 use serde::{Deserialize, Serialize};
 use std::io::{Read, Write};
 use std::path::Path;
@@ -93,21 +94,21 @@ pub fn main_if_child() -> Option<std::process::ExitCode> {
 
 /// Prints each report as a line the worker reads; never cancels (the worker kills instead).
 struct StdoutProgress {
-    last: Option<(String, std::time::Instant)>,
+    last: Option<(Stage, std::time::Instant)>,
 }
 
 impl geom::progress::Progress for StdoutProgress {
-    fn report(&mut self, stage: &str, fraction: f64) {
+    fn report(&mut self, stage: Stage, fraction: f64) {
         // At most about twenty lines a second per stage: the heartbeat reads one a second.
         let now = std::time::Instant::now();
         if let Some((s, t)) = &self.last
-            && s == stage
+            && *s == stage
             && now.duration_since(*t).as_millis() < 50
             && fraction < 1.0
         {
             return;
         }
-        self.last = Some((stage.to_string(), now));
+        self.last = Some((stage, now));
         let mut out = std::io::stdout().lock();
         let _ = writeln!(out, "{stage}\t{fraction}");
         let _ = out.flush();

@@ -1,29 +1,36 @@
 //! The bridge between the pipeline's `Progress` calls (on the blocking thread) and the
 //! heartbeat (on the runtime): stage names map onto one monotone job fraction.
 
-use geom::progress::CancelToken;
+use geom::progress::{CancelToken, Stage};
 use std::sync::{Arc, Mutex};
 
-/// Where each pipeline stage starts and how much of the job it spans.
-const STAGES: &[(&str, f64, f64)] = &[
-    ("layout", 0.0, 0.02),
-    // `quad` jobs: partition -> parameterize -> remesh -> images -> metrics -> morph.
-    ("partition", 0.0, 0.05),
-    ("layout_source", 0.02, 0.13),
-    ("layout_target", 0.15, 0.2),
-    ("layout_greedy", 0.02, 0.33),
-    ("straighten", 0.35, 0.05),
-    ("parameterize", 0.40, 0.15),
-    ("compose", 0.55, 0.05),
-    ("smooth", 0.60, 0.20),
-    // The opt-in global Newton steps after the sweeps.
-    ("newton", 0.78, 0.02),
-    ("remesh", 0.60, 0.10),
-    ("images", 0.70, 0.10),
-    ("metrics", 0.80, 0.18),
-    ("morph", 0.98, 0.02),
-    ("done", 1.0, 0.0),
-];
+/// Where each pipeline stage starts in the job and how much of it it spans (`quad` jobs:
+/// partition -> parameterize -> remesh -> images -> metrics -> morph; `homology`: basis or
+/// feature_cut -> parameterize -> compose -> smooth -> metrics -> meta_mesh). Exhaustive, so a
+/// new stage cannot be left out.
+fn span(stage: Stage) -> (f64, f64) {
+    match stage {
+        Stage::Layout => (0.0, 0.02),
+        Stage::Partition => (0.0, 0.05),
+        Stage::Basis | Stage::FeatureCut => (0.0, 0.10),
+        Stage::LayoutSource => (0.02, 0.13),
+        Stage::LayoutTarget => (0.15, 0.2),
+        Stage::LayoutGreedy => (0.02, 0.33),
+        Stage::Straighten => (0.35, 0.05),
+        Stage::Parameterize => (0.40, 0.15),
+        Stage::Compose => (0.55, 0.03),
+        Stage::Global => (0.58, 0.02),
+        Stage::Smooth => (0.60, 0.20),
+        // The opt-in global Newton steps after the sweeps.
+        Stage::Newton => (0.78, 0.02),
+        Stage::Remesh => (0.60, 0.10),
+        Stage::Images => (0.70, 0.10),
+        Stage::Metrics => (0.80, 0.15),
+        Stage::MetaMesh => (0.95, 0.03),
+        Stage::Morph => (0.98, 0.02),
+        Stage::Done => (1.0, 0.0),
+    }
+}
 
 /// Shared between the pipeline thread and the heartbeat task.
 #[derive(Debug, Clone, Default)]
@@ -42,14 +49,12 @@ impl Shared {
 }
 
 impl geom::progress::Progress for Shared {
-    fn report(&mut self, stage: &str, fraction: f64) {
-        let overall =
-            STAGES.iter().find(|s| s.0 == stage).map(|&(_, base, span)| base + span * fraction.clamp(0.0, 1.0));
+    fn report(&mut self, stage: Stage, fraction: f64) {
+        let (base, width) = span(stage);
+        let overall = base + width * fraction.clamp(0.0, 1.0);
         if let Ok(mut s) = self.state.lock() {
-            s.0 = stage.to_string();
-            if let Some(o) = overall {
-                s.1 = s.1.max(o);
-            }
+            s.0 = stage.name().to_string();
+            s.1 = s.1.max(overall);
         }
     }
     fn cancelled(&self) -> bool {
@@ -68,9 +73,9 @@ mod tests {
     #[test]
     fn fraction_is_monotone_and_cancel_is_seen() {
         let mut s = Shared::default();
-        s.report("smooth", 0.5);
+        s.report(Stage::Smooth, 0.5);
         assert_eq!(s.snapshot(), ("smooth".to_string(), 0.7));
-        s.report("layout", 1.0);
+        s.report(Stage::Layout, 1.0);
         assert_eq!(s.snapshot().1, 0.7);
         assert!(s.check().is_ok());
         let side = s.silent();

@@ -106,6 +106,7 @@ impl Running {
                         while let Ok(Some(line)) = lines.next_line().await {
                             if let Some((stage, f)) = line.split_once('\t')
                                 && let Ok(f) = f.parse::<f64>()
+                                && let Some(stage) = geom::progress::Stage::from_name(stage)
                             {
                                 geom::progress::Progress::report(&mut progress, stage, f);
                             }

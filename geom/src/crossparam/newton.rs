@@ -239,7 +239,7 @@ pub fn relax_newton(
     }
     for it in 0..opts.iterations {
         progress.check()?;
-        progress.report("newton", it as f64 / opts.iterations as f64);
+        progress.report(crate::progress::Stage::Newton, it as f64 / opts.iterations as f64);
         let tan: Vec<[V3; 2]> = map.face.iter().map(|&f| tangents(target.face_normal_raw(f))).collect();
         // Per face: gradient and clamped Hessian, in the order of `pairs`.
         let blocks: Vec<Option<([f64; 6], SMatrix<f64, 6, 6>)>> = face_list

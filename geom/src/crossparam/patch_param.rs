@@ -77,7 +77,7 @@ pub fn parameterize_patches(
         faces_of[p as usize].push(f);
     }
     progress.check()?;
-    progress.report("parameterize", 0.0);
+    progress.report(crate::progress::Stage::Parameterize, 0.0);
     // Patches are independent: flatten them in parallel, one vertex-renumbering scratch per
     // worker thread.
     let out = patches
@@ -89,7 +89,7 @@ pub fn parameterize_patches(
             |local_of, (pi, (patch, faces))| flatten_patch(r, pi, patch, faces, anchors, opts, local_of),
         )
         .collect::<Result<Vec<_>>>()?;
-    progress.report("parameterize", 1.0);
+    progress.report(crate::progress::Stage::Parameterize, 1.0);
     Ok(out)
 }
 

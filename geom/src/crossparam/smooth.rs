@@ -479,7 +479,7 @@ pub fn smooth(
     let mut next = vec![false; n];
     for it in 0..opts.iterations {
         progress.check()?;
-        progress.report("smooth", it as f64 / opts.iterations as f64);
+        progress.report(crate::progress::Stage::Smooth, it as f64 / opts.iterations as f64);
         for vi in 0..n {
             if is_fixed[vi] || !active[vi] {
                 continue;

@@ -54,7 +54,7 @@ pub fn greedy_layout<'m>(
     for (k, &(_, a, b)) in cand.iter().enumerate() {
         progress.check()?;
         if k % 16 == 0 {
-            progress.report("layout_greedy", k as f64 / cand.len().max(1) as f64);
+            progress.report(crate::progress::Stage::LayoutGreedy, k as f64 / cand.len().max(1) as f64);
         }
         if src.paths().len() >= max_paths || super::walks::is_complete(src, chi) {
             break;

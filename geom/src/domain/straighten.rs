@@ -22,7 +22,10 @@ pub fn straighten(t: &mut Tracer, rounds: usize, progress: &mut dyn Progress) ->
         for id in 0..n {
             progress.check()?;
             if id % 32 == 0 {
-                progress.report("straighten", (r as f64 + f64::from(id) / f64::from(n.max(1))) / rounds as f64);
+                progress.report(
+                    crate::progress::Stage::Straighten,
+                    (r as f64 + f64::from(id) / f64::from(n.max(1))) / rounds as f64,
+                );
             }
             if t.retrace(id)? {
                 this_round += 1;

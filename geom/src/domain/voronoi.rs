@@ -82,7 +82,7 @@ pub fn source_layout(
     });
     for (k, &ci) in order.iter().enumerate() {
         progress.check()?;
-        progress.report("layout_source", 0.8 * k as f64 / order.len().max(1) as f64);
+        progress.report(crate::progress::Stage::LayoutSource, 0.8 * k as f64 / order.len().max(1) as f64);
         let c = &cl.cuts[ci];
         let mask = cl.mask(c.i, c.j);
         let blocked = blocked_for_cut(t, &cl, ci);
@@ -229,7 +229,7 @@ pub fn target_layout(
     let mut force = false;
     while !queue.is_empty() {
         progress.check()?;
-        progress.report("layout_target", sid.len() as f64 / np.max(1) as f64);
+        progress.report(crate::progress::Stage::LayoutTarget, sid.len() as f64 / np.max(1) as f64);
         let mut progressed = false;
         let mut postponed = Vec::new();
         for &s in &queue {

@@ -149,7 +149,7 @@ pub(super) fn choose_global(
         report.fallback = Some("the per-patch composition is clean".into());
         return Ok((maps, None, Some(report)));
     }
-    progress.report("global", 0.0);
+    progress.report(crate::progress::Stage::Global, 0.0);
     let (rs, rt) = inputs.refined;
     let (sa, ta) = inputs.anchors;
     let patches = inputs.patches;

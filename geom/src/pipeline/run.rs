@@ -207,7 +207,7 @@ pub(super) fn measure_direction(
     progress: &mut dyn Progress,
 ) -> Result<(Mesh, MapMetrics)> {
     progress.check()?;
-    progress.report("metrics", 0.0);
+    progress.report(crate::progress::Stage::Metrics, 0.0);
     let mo = MetricsOptions { samples: o.metric_samples, ..Default::default() };
     let embedded = map.embed(from, to)?;
     let metrics = evaluate_map(from, to, &embedded, Some(anchors), None, &mo)?;
@@ -256,7 +256,7 @@ pub fn run_map(
     let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).collect();
     let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).collect();
     clock.lap("setup");
-    progress.report("layout", 0.0);
+    progress.report(crate::progress::Stage::Layout, 0.0);
     // Denser edge nodes leave more room between paths; a layout that cannot be completed at
     // the requested density is rebuilt at higher ones before giving up.
     let mut edge_nodes = o.layout.edge_nodes;
@@ -341,7 +341,7 @@ pub fn run_map(
     let (ps, pt) = (ps?, pt?);
     clock.lap("parameterize");
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
-    progress.report("compose", 0.0);
+    progress.report(crate::progress::Stage::Compose, 0.0);
     let (s2t, t2s) =
         both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
     clock.lap("compose");
@@ -432,7 +432,7 @@ pub fn run_map(
     report.timings_ms = clock.1;
     let json = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal(e.to_string()))?;
     arts.push(Artifact { name: "metrics.json".into(), content_type: "application/json", bytes: json });
-    progress.report("done", 1.0);
+    progress.report(crate::progress::Stage::Done, 1.0);
     Ok((report, arts))
 }
 
@@ -467,21 +467,21 @@ mod cancel_tests {
     use super::*;
     use crate::mesh::shapes;
     use crate::pipeline::MapOptions;
-    use crate::progress::CancelToken;
+    use crate::progress::{CancelToken, Stage};
 
     /// Cancels its token when a stage starts and records every stage reported.
     struct CancelAt {
-        stage: &'static str,
+        stage: Stage,
         token: CancelToken,
-        seen: Vec<String>,
+        seen: Vec<Stage>,
     }
 
     impl Progress for CancelAt {
-        fn report(&mut self, stage: &str, _fraction: f64) {
+        fn report(&mut self, stage: Stage, _fraction: f64) {
             if stage == self.stage {
                 self.token.cancel();
             }
-            self.seen.push(stage.to_string());
+            self.seen.push(stage);
         }
         fn cancelled(&self) -> bool {
             self.token.is_cancelled()
@@ -501,10 +501,14 @@ mod cancel_tests {
         let t = t.unwrap();
         let anchors: Vec<[u64; 2]> = [0u64, 5, 9, 13, 21, 40].iter().map(|&i| [i, i]).collect();
         let spec = JobSpec { method: Method::Voronoi, anchors, features: Vec::new(), options: MapOptions::default() };
-        let mut p = CancelAt { stage: "smooth", token: CancelToken::default(), seen: Vec::new() };
+        let mut p = CancelAt { stage: Stage::Smooth, token: CancelToken::default(), seen: Vec::new() };
         let r = run_map(&spec, &s, &t, &mut p);
         assert!(matches!(r, Err(Error::Cancelled)), "{:?}", r.err());
-        assert!(p.seen.iter().any(|s| s == "smooth"), "{:?}", p.seen);
-        assert!(!p.seen.iter().any(|s| s == "metrics" || s == "done"), "ran on after the cancel: {:?}", p.seen);
+        assert!(p.seen.contains(&Stage::Smooth), "{:?}", p.seen);
+        assert!(
+            !p.seen.iter().any(|s| matches!(s, Stage::Metrics | Stage::Done)),
+            "ran on after the cancel: {:?}",
+            p.seen
+        );
     }
 }

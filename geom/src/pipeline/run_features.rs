@@ -69,7 +69,7 @@ pub(super) fn run_features(
 ) -> Result<(MapReport, Vec<Artifact>)> {
     let o = &spec.options;
     clock.lap("setup");
-    progress.report("feature_cut", 0.0);
+    progress.report(crate::progress::Stage::FeatureCut, 0.0);
     let fo = FeatureMapOptions {
         stretch_iterations: o.domain_stretch_iterations,
         align: o.align_curves.then(CurveAlignOptions::default),
@@ -116,7 +116,7 @@ pub(super) fn run_features(
     let mut arts = artifacts::maps_and_meshes(&f.s2t, &f.t2s, &f.on_target, &f.on_source);
     let mut morph = None;
     if o.meta_mesh {
-        progress.report("meta_mesh", 0.0);
+        progress.report(crate::progress::Stage::MetaMesh, 0.0);
         // On a refinement (same surface, more vertices) when the cut lives on one.
         let (ms, mt) = (r.source.cut_mesh(source), r.target.cut_mesh(target));
         let m = crate::homology::feature_overlay::feature_meta_mesh(&r.source, &r.target, ms, mt);
@@ -136,7 +136,7 @@ pub(super) fn run_features(
     let mut report = pair_report(spec, pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
     report.features = Some(report_f);
     finish_report(&mut report, clock, &mut arts)?;
-    progress.report("done", 1.0);
+    progress.report(crate::progress::Stage::Done, 1.0);
     Ok((report, arts))
 }
 

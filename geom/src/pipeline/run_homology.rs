@@ -132,7 +132,7 @@ pub fn run_homology(
     }
     let o = &spec.options;
     clock.lap("setup");
-    progress.report("basis", 0.0);
+    progress.report(crate::progress::Stage::Basis, 0.0);
     let (mut basis, mut rotation, mut want) = (o.basis, o.rotation, None);
     if let Some(entries) = &o.matching {
         let g = crate::topology::summary(source).genus.max(0) as usize;
@@ -184,7 +184,7 @@ pub fn run_homology(
     let mut meta = None;
     let mut morph = None;
     if o.meta_mesh {
-        progress.report("meta_mesh", 0.0);
+        progress.report(crate::progress::Stage::MetaMesh, 0.0);
         let angle = std::f64::consts::TAU * r.side_shift as f64 / (4 * g) as f64;
         let (stats, m) = meta_outputs(crate::homology::overlay::meta_mesh(&r.source, &r.target, angle), o, &mut arts);
         meta = Some(stats);
@@ -215,7 +215,7 @@ pub fn run_homology(
     let mut report = pair_report(spec, pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
     report.homology = Some(report_h);
     finish_report(&mut report, clock, &mut arts)?;
-    progress.report("done", 1.0);
+    progress.report(crate::progress::Stage::Done, 1.0);
     Ok((report, arts))
 }
 
@@ -256,7 +256,7 @@ pub(super) fn finish_pair(
     let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).chain(fixed.0.iter().copied()).collect();
     let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).chain(fixed.1.iter().copied()).collect();
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
-    progress.report("smooth", 0.0);
+    progress.report(crate::progress::Stage::Smooth, 0.0);
     let mut side = progress.silent();
     let (a, b) = both(
         || finish_direction(target, source, t2s, &ta, &rev, o, &mut side, &mut || {}),

@@ -219,27 +219,27 @@ pub fn run_remesh(
     };
     clock.lap("parameterize");
     progress.check()?;
-    progress.report("remesh", 0.0);
+    progress.report(crate::progress::Stage::Remesh, 0.0);
     let rm = remesh_all(&built, o.level, o.adaptive_epsilon, meshes)?;
     clock.lap("remesh");
     let mut arts = Vec::new();
     let image_level = o.image_level.unwrap_or(o.level.min(8));
     if image_level > 0 {
         progress.check()?;
-        progress.report("images", 0.0);
+        progress.report(crate::progress::Stage::Images, 0.0);
         arts.extend(geometry_images(&built, image_level)?);
         clock.lap("images");
     }
     progress.check()?;
-    progress.report("metrics", 0.0);
+    progress.report(crate::progress::Stage::Metrics, 0.0);
     let mut per_model = Vec::with_capacity(meshes.len());
     for (m, mesh) in meshes.iter().enumerate() {
         progress.check()?;
-        progress.report("metrics", m as f64 / meshes.len() as f64);
+        progress.report(crate::progress::Stage::Metrics, m as f64 / meshes.len() as f64);
         per_model.push(model_report(&built, m, mesh, &rm, o.metric_samples)?);
     }
     clock.lap("metrics");
-    progress.report("morph", 0.0);
+    progress.report(crate::progress::Stage::Morph, 0.0);
     arts.extend(mesh_artifacts(&built, &rm)?);
     arts.extend(morph_artifacts(spec, &rm)?);
     clock.lap("artifacts");
@@ -259,7 +259,7 @@ pub fn run_remesh(
     };
     let json = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal(e.to_string()))?;
     arts.push(Artifact { name: "metrics.json".into(), content_type: "application/json", bytes: json });
-    progress.report("done", 1.0);
+    progress.report(crate::progress::Stage::Done, 1.0);
     Ok((report, arts))
 }
 

@@ -67,7 +67,7 @@ pub fn consistent_parameterization(
     let mut want: Option<Vec<usize>> = None;
     for (m, mesh) in meshes.iter().enumerate() {
         progress.check()?;
-        progress.report("partition", m as f64 / meshes.len() as f64);
+        progress.report(crate::progress::Stage::Partition, m as f64 / meshes.len() as f64);
         let points = [rows[0][m], rows[1][m], rows[2][m], rows[3][m]];
         let features: Vec<VertexId> = rows[4..].iter().map(|r| r[m]).collect();
         let part = partition_genus0_sided(mesh, points, &features, want.as_deref(), &opts.partition)?;

@@ -156,7 +156,7 @@ pub fn coarse_to_fine(
         let (u, v) = base.from_to[i];
         if i % 512 == 0 {
             progress.check()?;
-            progress.report("parameterize", 1.0 - i as f64 / base.from_to.len().max(1) as f64);
+            progress.report(crate::progress::Stage::Parameterize, 1.0 - i as f64 / base.from_to.len().max(1) as f64);
         }
         for &f in &base.history.rewritten[i] {
             for w in st.faces[f as usize].iter_mut() {

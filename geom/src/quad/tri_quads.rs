@@ -179,7 +179,7 @@ pub fn tri_quads(meshes: &[&Mesh], rows: &[Vec<VertexId>], progress: &mut dyn Pr
         let mut stretch = Vec::with_capacity(params.len());
         let mut soup = PatchSoup::default();
         for (pi, pp) in params.iter_mut().enumerate() {
-            progress.report("parameterize", pi as f64 / patches.len() as f64);
+            progress.report(crate::progress::Stage::Parameterize, pi as f64 / patches.len() as f64);
             let n = pp.local.n_vertices();
             let mut fixed = vec![false; n];
             for v in &pp.boundary {

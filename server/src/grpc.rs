@@ -71,14 +71,6 @@ impl Surfmap for GrpcApi {
     async fn submit_job(&self, req: Request<pb::SubmitJobRequest>) -> Result<Response<pb::Job>, Status> {
         let o = owner(&self.state, &req)?;
         let r = req.into_inner();
-        let limit = self.state.service.limits.max_json_bytes;
-        if r.spec_json.len() > limit {
-            return Err(crate::error::ApiError::too_large(format!(
-                "spec_json of {} bytes exceeds the limit of {limit} for JSON",
-                r.spec_json.len()
-            ))
-            .into());
-        }
         let key = Some(r.idempotency_key).filter(|k| !k.is_empty());
         let meshes = if r.meshes.is_empty() { vec![r.source, r.target] } else { r.meshes };
         let (j, _) = self.state.service.submit(&o, &meshes, r.spec_json.as_bytes(), key).await?;

@@ -225,7 +225,15 @@ impl JobService {
             };
             summaries.push(self.summary(owner, &role, id).await?);
         }
-        // The meshes first (404), then the spec: parsed once, here, into the typed job.
+        // The meshes first (404), then the spec: bounded (REST JSON bodies are bounded before
+        // they are read; this covers multipart parts and gRPC), parsed once, here.
+        if spec.len() > self.limits.max_json_bytes {
+            return Err(ApiError::too_large(format!(
+                "the spec of {} bytes exceeds the limit of {} for JSON",
+                spec.len(),
+                self.limits.max_json_bytes
+            )));
+        }
         let job = &parse_spec(spec)?;
         job.check(&summaries)?;
         let estimate = job.memory_estimate(&summaries);

@@ -26,18 +26,20 @@ async fn long_job(api: &Api) -> String {
     j["id"].as_str().unwrap().to_string()
 }
 
-/// Waits until the job is running in `stage` (any stage when `None`); returns when it was seen.
-async fn wait_stage(api: &Api, id: &str, stage: Option<&str>) -> Value {
+/// Waits until the job is running in `stage` (any stage when `None`), on its `attempt`-th
+/// attempt when given; returns the job as then seen.
+async fn wait_stage(api: &Api, id: &str, stage: Option<&str>, attempt: Option<i64>) -> Value {
     let (api, id) = (api.clone(), id.to_string());
     wait_for(Duration::from_secs(300), || {
         let (api, id) = (api.clone(), id.clone());
         async move {
             let j = api.job(&id).await;
-            (j["state"] == "running" && stage.is_none_or(|s| j["stage"] == s)).then_some(j)
+            let at = stage.is_none_or(|s| j["stage"] == s) && attempt.is_none_or(|a| j["attempts"] == a);
+            (j["state"] == "running" && at).then_some(j)
         }
     })
     .await
-    .unwrap_or_else(|| panic!("job {id} never ran in stage {stage:?}"))
+    .unwrap_or_else(|| panic!("job {id} never ran in stage {stage:?} (attempt {attempt:?})"))
 }
 
 /// Polls every 20 ms until the job is in a terminal state; the time it took.
@@ -59,7 +61,7 @@ async fn cancel_and_time_limit_land_within_a_second_in_the_longest_stage() {
     let (mut server, base) = env.server(&["--workers", "1", "--time-limit-secs", "600"]);
     let api = Api::new(&base);
     let id = long_job(&api).await;
-    wait_stage(&api, &id, Some("smooth")).await;
+    wait_stage(&api, &id, Some("smooth"), None).await;
     let asked = Instant::now();
     let r = api.req(reqwest::Method::POST, &format!("/v1/jobs/{id}/cancel")).send().await.unwrap();
     assert_eq!(r.status(), 200);
@@ -73,7 +75,7 @@ async fn cancel_and_time_limit_land_within_a_second_in_the_longest_stage() {
     let (_server, base) = env.server(&["--workers", "1", "--time-limit-secs", "4"]);
     let api = Api::new(&base);
     let id = long_job(&api).await;
-    wait_stage(&api, &id, None).await;
+    wait_stage(&api, &id, None, None).await;
     let (j, _) = time_to_end(&api, &id, Instant::now()).await;
     assert_eq!((j["state"].as_str(), j["error"]["code"].as_str()), (Some("failed"), Some("time_limit")), "{j}");
     let ran = j["finished_at_ms"].as_i64().unwrap() - j["started_at_ms"].as_i64().unwrap();
@@ -88,7 +90,7 @@ async fn sigterm_with_a_two_second_grace_releases_the_job_and_exits() {
     let api = Api::new(&base);
     let mut worker = env.worker("w", &["--shutdown-grace-secs", "2"]);
     let id = long_job(&api).await;
-    wait_stage(&api, &id, Some("smooth")).await;
+    wait_stage(&api, &id, Some("smooth"), None).await;
     let asked = Instant::now();
     worker.signal("TERM");
     let status = worker.wait_exit(Duration::from_secs(10));
@@ -110,14 +112,7 @@ async fn a_job_process_that_dies_fails_the_job_not_the_server() {
     let api = Api::new(&base);
     let id = long_job(&api).await;
     for attempt in 1..=2 {
-        let seen = wait_for(Duration::from_secs(300), || {
-            let (api, id) = (api.clone(), id.clone());
-            async move {
-                let j = api.job(&id).await;
-                (j["state"] == "running" && j["stage"] == "smooth" && j["attempts"] == attempt).then_some(())
-            }
-        });
-        assert!(seen.await.is_some(), "attempt {attempt} never reached the smooth stage: {}", api.job(&id).await);
+        wait_stage(&api, &id, Some("smooth"), Some(attempt)).await;
         let children = std::process::Command::new("pgrep").arg("-P").arg(server.pid().to_string()).output().unwrap();
         let pids = String::from_utf8_lossy(&children.stdout).to_string();
         let pid = pids.split_whitespace().next().unwrap_or_else(|| panic!("no job process under the server"));

@@ -29,6 +29,26 @@ pub async fn shutdown_signal() {
     }
 }
 
+/// The whole `main` of both binaries: a job's child process (`<exe> __run-job DIR`) runs its
+/// job and exits; otherwise `args` parses the command line and `run` runs on a multi-threaded
+/// runtime under [`process_main`].
+pub fn binary_main<A, F>(name: &str, args: impl FnOnce() -> A, run: impl FnOnce(A) -> F) -> std::process::ExitCode
+where
+    F: std::future::Future<Output = anyhow::Result<()>>,
+{
+    if let Some(code) = main_if_child() {
+        return code;
+    }
+    let args = args();
+    match tokio::runtime::Builder::new_multi_thread().enable_all().build() {
+        Ok(rt) => rt.block_on(process_main(name, run(args))),
+        Err(e) => {
+            eprintln!("{name}: cannot start the runtime: {e}");
+            std::process::ExitCode::from(1)
+        }
+    }
+}
+
 /// The body of both binaries' `main`: stderr logging (`RUST_LOG`, default `info`), then `run`;
 /// an error is printed with its causes and exits 1.
 pub async fn process_main(

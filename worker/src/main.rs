@@ -49,18 +49,7 @@ struct Args {
 }
 
 fn main() -> std::process::ExitCode {
-    // A job's child process (`surfmap-worker __run-job DIR`) runs the job and exits.
-    if let Some(code) = surfmap_worker::main_if_child() {
-        return code;
-    }
-    let args = Args::parse();
-    match tokio::runtime::Builder::new_multi_thread().enable_all().build() {
-        Ok(rt) => rt.block_on(surfmap_worker::process_main("surfmap-worker", run(args))),
-        Err(e) => {
-            eprintln!("surfmap-worker: cannot start the runtime: {e}");
-            std::process::ExitCode::from(1)
-        }
-    }
+    surfmap_worker::binary_main("surfmap-worker", Args::parse, run)
 }
 
 async fn run(a: Args) -> anyhow::Result<()> {

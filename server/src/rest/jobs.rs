@@ -1,6 +1,6 @@
 //! Job routes: submit (JSON or multipart), get, list, cancel, and SSE progress.
 
-use super::{Owner, P, Q, is_multipart, multipart_error, read_limited};
+use super::{Owner, P, Q, is_multipart, multipart_error, read_limited, reserve_upload};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
 use crate::service::{format_hint, job_filter};
@@ -51,13 +51,6 @@ async fn multipart_job(st: &AppState, owner: &str, mut mp: Multipart) -> Result<
         match name.as_str() {
             "source" => source = Some(mesh_part(st, owner, &bytes, file).await?),
             "target" => target = Some(mesh_part(st, owner, &bytes, file).await?),
-            "spec" if bytes.len() > st.service.limits.max_json_bytes => {
-                return Err(ApiError::too_large(format!(
-                    "the spec part of {} bytes exceeds the limit of {} for JSON",
-                    bytes.len(),
-                    st.service.limits.max_json_bytes
-                )));
-            }
             "spec" => spec = Some(bytes.to_vec()),
             "mesh" => meshes.push(mesh_part(st, owner, &bytes, file).await?),
             other => return Err(ApiError::bad_request("invalid_multipart", format!("unexpected part {other:?}"))),
@@ -83,13 +76,7 @@ pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Re
     let key = req.headers().get("idempotency-key").and_then(|v| v.to_str().ok()).map(str::to_string);
     let (meshes, spec) = if is_multipart(req.headers()) {
         // Mesh parts are uploads: they share the upload memory budget.
-        let declared = req
-            .headers()
-            .get(header::CONTENT_LENGTH)
-            .and_then(|v| v.to_str().ok())
-            .and_then(|v| v.parse::<usize>().ok());
-        let limit = st.service.limits.max_body_bytes;
-        let _held = st.service.limits.uploads.reserve(declared.unwrap_or(limit).min(limit))?;
+        let _held = reserve_upload(&st, req.headers())?;
         let mp = Multipart::from_request(req, &st)
             .await
             .map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;

@@ -1,6 +1,6 @@
 //! `POST /v1/meshes`: a raw body or a multipart file part.
 
-use super::{Owner, Q, is_multipart, multipart_error, read_limited};
+use super::{Owner, Q, is_multipart, multipart_error, read_limited, reserve_upload};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
 use crate::service::format_hint;
@@ -45,13 +45,7 @@ pub async fn upload_mesh(
     Q(q): Q<FormatQuery>,
     req: Request,
 ) -> Result<(StatusCode, Json<MeshView>), ApiError> {
-    let declared = req
-        .headers()
-        .get(axum::http::header::CONTENT_LENGTH)
-        .and_then(|v| v.to_str().ok())
-        .and_then(|v| v.parse::<usize>().ok());
-    let limit = st.service.limits.max_body_bytes;
-    let _held = st.service.limits.uploads.reserve(declared.unwrap_or(limit).min(limit))?;
+    let _held = reserve_upload(&st, req.headers())?;
     let (bytes, ext) = if is_multipart(req.headers()) {
         let mp = Multipart::from_request(req, &st)
             .await

@@ -57,9 +57,8 @@ impl<T: serde::de::DeserializeOwned + Send, S: Send + Sync> FromRequestParts<S> 
 /// # Errors
 /// 413 `payload_too_large`.
 pub async fn read_limited(headers: &HeaderMap, body: Body, limit: usize) -> Result<Bytes, ApiError> {
-    let declared =
-        headers.get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.parse::<u64>().ok());
-    if declared.is_some_and(|n| n > limit as u64) {
+    let declared = declared_length(headers);
+    if declared.is_some_and(|n| n > limit) {
         return Err(ApiError::too_large(format!(
             "request body of {} bytes exceeds the limit of {limit}",
             declared.unwrap_or(0)
@@ -68,6 +67,24 @@ pub async fn read_limited(headers: &HeaderMap, body: Body, limit: usize) -> Resu
     axum::body::to_bytes(body, limit)
         .await
         .map_err(|e| ApiError::too_large(format!("request body exceeds the limit of {limit} bytes ({e})")))
+}
+
+/// The body length a request declares (`Content-Length`), if any.
+pub fn declared_length(headers: &HeaderMap) -> Option<usize> {
+    headers.get(header::CONTENT_LENGTH).and_then(|v| v.to_str().ok()).and_then(|v| v.parse().ok())
+}
+
+/// Reserves the upload memory a request's body may take (its declared length, or the body
+/// limit when it declares none) before the body is read.
+///
+/// # Errors
+/// 429 `uploads_busy` when concurrent uploads hold the budget.
+pub fn reserve_upload(
+    st: &crate::AppState,
+    headers: &HeaderMap,
+) -> Result<tokio::sync::OwnedSemaphorePermit, ApiError> {
+    let limit = st.service.limits.max_body_bytes;
+    st.service.limits.uploads.reserve(declared_length(headers).unwrap_or(limit).min(limit))
 }
 
 /// True for a `multipart/form-data` request.

@@ -161,7 +161,7 @@ pub fn map(
     let s = read(source)?.mesh;
     let t = read(target)?.mesh;
     let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
-    let (report, artifacts) = geom::pipeline::run_map(&spec, &s, &t, &mut progress)?;
+    let (report, artifacts) = geom::pipeline::run_job(&spec, &[s, t], &mut progress)?;
     finish(&progress, out, &artifacts, &report)
 }
 
@@ -169,10 +169,10 @@ pub fn remesh(meshes: &[std::path::PathBuf], spec: &Path, out: &Path) -> Result<
     use std::io::IsTerminal;
     let bytes =
         std::fs::read(spec).map_err(|e| geom::InputError::Invalid(format!("cannot read {}: {e}", spec.display())))?;
-    let spec = geom::pipeline::RemeshSpec::from_json(&bytes)?;
+    let spec = geom::pipeline::JobSpec::from_json(&bytes)?;
     let models = meshes.iter().map(|m| read(m).map(|r| r.mesh)).collect::<Result<Vec<_>>>()?;
     let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
-    let (report, artifacts) = geom::pipeline::run_remesh(&spec, &models, &mut progress)?;
+    let (report, artifacts) = geom::pipeline::run_job(&spec, &models, &mut progress)?;
     finish(&progress, out, &artifacts, &report)
 }
 

@@ -26,7 +26,7 @@ fn malformed_spec() {
     assert!(err.contains("[invalid_spec]"), "{err}");
     let (code, err) = run_map("cow.off", "cow.off", r#"{"method": "nope", "anchors": []}"#, "spec2");
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("[invalid_spec]") && err.contains("nope"), "{err}");
+    assert!(err.contains("[unknown_method]") && err.contains("nope") && err.contains("voronoi, greedy"), "{err}");
     let (code, err) = run_map(
         "cow.off",
         "cow.off",

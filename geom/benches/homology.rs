@@ -7,7 +7,8 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use geom::homology::{CanonicalBasisOptions, canonical_basis};
 use geom::io::{ReadOptions, read_path};
 use geom::mesh::{Mesh, VertexId};
-use geom::pipeline::{JobSpec, MapOptions, Method, run_map};
+use geom::pipeline::homology::run as run_map;
+use geom::pipeline::{HomologyOptions, HomologySpec};
 use geom::progress::NoProgress;
 
 mod common;
@@ -31,12 +32,7 @@ fn bench(c: &mut Criterion) {
     }
     let s = load("kitten.nf20k.off");
     let t = bent(&s);
-    let spec = JobSpec {
-        method: Method::Homology,
-        anchors: vec![[0, 0]],
-        features: Vec::new(),
-        options: MapOptions::default(),
-    };
+    let spec = HomologySpec { anchors: vec![[0, 0]], features: Vec::new(), options: HomologyOptions::default() };
     g.bench_function("kitten_bent_genus1_map", |b| b.iter(|| run_map(&spec, &s, &t, &mut NoProgress).expect("map")));
     g.finish();
 }

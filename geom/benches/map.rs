@@ -5,7 +5,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use geom::io::{ReadOptions, read_path};
-use geom::pipeline::{JobSpec, MapOptions, Method, run_map};
+use geom::pipeline::voronoi::run as run_map;
+use geom::pipeline::{LayoutSpec, MapOptions, Method};
 use geom::progress::NoProgress;
 
 mod common;
@@ -18,9 +19,9 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("map");
     g.sample_size(10);
     for method in [Method::Voronoi, Method::Greedy] {
-        let spec = JobSpec { method, anchors: anchors.clone(), features: Vec::new(), options: MapOptions::default() };
+        let spec = LayoutSpec { anchors: anchors.clone(), options: MapOptions::default() };
         g.bench_function(format!("armadillo_bent_45_{}", method.name()), |b| {
-            b.iter(|| run_map(&spec, &s, &t, &mut NoProgress).expect("map"))
+            b.iter(|| run_map(method, &spec, &s, &t, &mut NoProgress).expect("map"))
         });
     }
     // 58k against 6k: every vertex of the simplification is an armadillo vertex (half-edge
@@ -32,9 +33,9 @@ fn bench(c: &mut Criterion) {
             .expect("decimate");
     let anchors: Vec<[u64; 2]> =
         fps(&coarse.mesh, 45).into_iter().map(|a| [u64::from(coarse.kept[a as usize].0), a]).collect();
-    let spec = JobSpec { method: Method::Voronoi, anchors, features: Vec::new(), options: MapOptions::default() };
+    let spec = LayoutSpec { anchors, options: MapOptions::default() };
     g.bench_function("armadillo_58k_vs_6k_45_voronoi", |b| {
-        b.iter(|| run_map(&spec, &fine, &coarse.mesh, &mut NoProgress).expect("map"))
+        b.iter(|| run_map(Method::Voronoi, &spec, &fine, &coarse.mesh, &mut NoProgress).expect("map"))
     });
     g.finish();
 }

@@ -6,7 +6,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use geom::io::{ReadOptions, read_path};
 use geom::mesh::{Mesh, VertexId};
-use geom::pipeline::{RemeshSpec, remesh_all_for_bench, run_remesh};
+use geom::pipeline::quad::run as run_remesh;
+use geom::pipeline::{JobSpec, remesh_all_for_bench};
 use geom::progress::NoProgress;
 use geom::quad::consistent::{ConsistentOptions, consistent_parameterization};
 
@@ -32,12 +33,14 @@ fn bench(c: &mut Criterion) {
     g.bench_function("smpl_pair_remesh_level8", |b| b.iter(|| remesh_all_for_bench(&cp, 8).expect("remesh")));
     let bunny = load("bunny.off");
     let ids = fps(&bunny, 4);
-    let spec = RemeshSpec::from_json(
+    let JobSpec::Quad(spec) = JobSpec::from_json(
         serde_json::json!({"method": "quad", "anchors": ids.iter().map(|&i| [i]).collect::<Vec<_>>(), "options": {"level": 6}})
             .to_string()
             .as_bytes(),
     )
-    .expect("spec");
+    .expect("spec") else {
+        unreachable!("a quad spec")
+    };
     g.bench_function("bunny_job_level6", |b| {
         b.iter(|| run_remesh(&spec, std::slice::from_ref(&bunny), &mut NoProgress).expect("job"))
     });

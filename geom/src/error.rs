@@ -85,6 +85,9 @@ pub enum InputError {
     Features(String),
     #[error("invalid job spec: {0}")]
     Spec(String),
+    /// The spec names no method this service runs (the message lists them).
+    #[error("{0}")]
+    UnknownMethod(String),
     #[error("no consistent patch layout: {0}")]
     LayoutConflict(String),
     /// An option's value lies outside its documented range (the message names both).
@@ -122,6 +125,7 @@ impl InputError {
             InputError::Anchors(_) => "invalid_anchors",
             InputError::Features(_) => "invalid_features",
             InputError::Spec(_) => "invalid_spec",
+            InputError::UnknownMethod(_) => "unknown_method",
             InputError::LayoutConflict(_) => "layout_conflict",
             InputError::OptionRange(_) => "option_out_of_range",
             InputError::OverBudget { .. } => "over_budget",

@@ -22,6 +22,7 @@ pub mod mesh;
 pub mod metrics;
 pub mod param;
 pub mod pipeline;
+pub mod planar;
 pub mod progress;
 pub mod quad;
 pub mod simplify;

@@ -31,7 +31,6 @@ pub enum Stage {
     Compose,
     Global,
     Smooth,
-    Newton,
     Basis,
     FeatureCut,
     MetaMesh,
@@ -45,7 +44,7 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage.
-    pub const ALL: [Stage; 19] = [
+    pub const ALL: [Stage; 18] = [
         Stage::Layout,
         Stage::LayoutSource,
         Stage::LayoutTarget,
@@ -55,7 +54,6 @@ impl Stage {
         Stage::Compose,
         Stage::Global,
         Stage::Smooth,
-        Stage::Newton,
         Stage::Basis,
         Stage::FeatureCut,
         Stage::MetaMesh,
@@ -79,7 +77,6 @@ impl Stage {
             Stage::Compose => "compose",
             Stage::Global => "global",
             Stage::Smooth => "smooth",
-            Stage::Newton => "newton",
             Stage::Basis => "basis",
             Stage::FeatureCut => "feature_cut",
             Stage::MetaMesh => "meta_mesh",

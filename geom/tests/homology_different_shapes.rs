@@ -4,18 +4,19 @@
 //! reproduces) and the base anchors exact.
 
 use geom::mesh::Mesh;
-use geom::pipeline::{JobSpec, MapOptions, MapReport, Method, run_map};
+use geom::pipeline::homology::HomologyMapReport;
+use geom::pipeline::homology::run as run_map;
+use geom::pipeline::{HomologyOptions, HomologySpec};
 use geom::progress::NoProgress;
 
 mod common;
 use common::load;
 
-fn run(s: &Mesh, t: &Mesh, basis: [usize; 2], rotation: usize) -> MapReport {
-    let spec = JobSpec {
-        method: Method::Homology,
+fn run(s: &Mesh, t: &Mesh, basis: [usize; 2], rotation: usize) -> HomologyMapReport {
+    let spec = HomologySpec {
         features: Vec::new(),
         anchors: vec![[0, 0]],
-        options: MapOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
+        options: HomologyOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
     };
     run_map(&spec, s, t, &mut NoProgress).unwrap().0
 }
@@ -27,12 +28,12 @@ fn eight_to_cup_in_two_homotopy_classes_without_flips() {
     let mut h1s = Vec::new();
     for basis in [[2, 0], [2, 2]] {
         let r = run(&s, &t, basis, 0);
-        for m in [&r.source_to_target, &r.target_to_source] {
+        for m in [&r.pair.source_to_target, &r.pair.target_to_source] {
             assert_eq!(m.flipped_faces, 0, "basis {basis:?}: {m:?}");
             assert!(m.anchor_error_max.unwrap() <= 1e-9, "basis {basis:?}: {m:?}");
             assert!(m.off_surface_max <= 1e-9, "basis {basis:?}: {m:?}");
         }
-        let h = r.homology.unwrap();
+        let h = r.homology;
         h1s.push(h.h1_reference.unwrap_or(h.h1));
     }
     assert_ne!(h1s[0], h1s[1], "two different classes");
@@ -48,19 +49,18 @@ fn kitten_to_rocker_arm_in_two_homotopy_classes_without_flips() {
     let t = load("rocker_arm/rocker-arm.obj");
     let mut h1s = Vec::new();
     for rotation in [1, 2] {
-        let spec = JobSpec {
-            method: Method::Homology,
+        let spec = HomologySpec {
             features: Vec::new(),
             anchors: vec![[0, 0]],
-            options: MapOptions { metric_samples: 5000, rotation, ..Default::default() },
+            options: HomologyOptions { metric_samples: 5000, rotation, ..Default::default() },
         };
         let (r, arts) = run_map(&spec, &s, &t, &mut NoProgress).unwrap();
-        for m in [&r.source_to_target, &r.target_to_source] {
+        for m in [&r.pair.source_to_target, &r.pair.target_to_source] {
             assert_eq!(m.flipped_faces, 0, "rotation {rotation}: {m:?}");
             assert!(m.anchor_error_max.unwrap() <= 1e-9, "rotation {rotation}: {m:?}");
         }
         common::source_on_target(&arts, &s, &t);
-        h1s.push(r.homology.unwrap().h1);
+        h1s.push(r.homology.h1);
     }
     assert_ne!(h1s[0], h1s[1], "two different classes");
 }

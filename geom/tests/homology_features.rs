@@ -6,7 +6,8 @@
 
 use geom::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
 use geom::mesh::{Mesh, VertexId};
-use geom::pipeline::{FeatureSpec, JobSpec, MapOptions, MapReport, Method, run_map};
+use geom::pipeline::features::run as run_map;
+use geom::pipeline::{FeatureSpec, HomologyOptions, HomologySpec, features::FeatureMapReport};
 use geom::progress::NoProgress;
 
 mod common;
@@ -18,7 +19,7 @@ fn features(m: &Mesh, k: usize) -> Vec<Vec<VertexId>> {
     common::feature_curves(m, k, 0.06, 2)
 }
 
-fn spec(curves: &[Vec<VertexId>], anchors: Vec<[u64; 2]>) -> JobSpec {
+fn spec(curves: &[Vec<VertexId>], anchors: Vec<[u64; 2]>) -> HomologySpec {
     spec_pairs(curves.iter().zip(curves), anchors)
 }
 
@@ -26,25 +27,24 @@ fn spec(curves: &[Vec<VertexId>], anchors: Vec<[u64; 2]>) -> JobSpec {
 fn spec_pairs<'a>(
     pairs: impl Iterator<Item = (&'a Vec<VertexId>, &'a Vec<VertexId>)>,
     anchors: Vec<[u64; 2]>,
-) -> JobSpec {
+) -> HomologySpec {
     let raw = |p: &Vec<VertexId>| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
-    JobSpec {
-        method: Method::Homology,
+    HomologySpec {
         anchors,
         features: pairs.map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) }).collect(),
-        options: MapOptions { metric_samples: 5000, ..Default::default() },
+        options: HomologyOptions { metric_samples: 5000, ..Default::default() },
     }
 }
 
 /// Runs a job on a same-shape pair (vertex `i` ↔ vertex `i`) and checks what every feature job
 /// must satisfy; returns the report and the mean ground-truth error over √area.
-fn check(s: &Mesh, t: &Mesh, sp: &JobSpec) -> (MapReport, f64) {
+fn check(s: &Mesh, t: &Mesh, sp: &HomologySpec) -> (FeatureMapReport, f64) {
     let (r, gt, _) = check_mapped(s, t, sp);
     (r, gt)
 }
 
 /// [`check`], also returning the source re-embedded on the target.
-fn check_mapped(s: &Mesh, t: &Mesh, sp: &JobSpec) -> (MapReport, f64, Mesh) {
+fn check_mapped(s: &Mesh, t: &Mesh, sp: &HomologySpec) -> (FeatureMapReport, f64, Mesh) {
     let (report, arts) = run_map(sp, s, t, &mut NoProgress).unwrap();
     common::assert_artifacts(
         &arts,
@@ -59,7 +59,7 @@ fn check_mapped(s: &Mesh, t: &Mesh, sp: &JobSpec) -> (MapReport, f64, Mesh) {
     );
     let glb = arts.iter().find(|a| a.name == "morph.glb").unwrap();
     assert_eq!(&glb.bytes[..4], b"glTF");
-    let f = report.features.as_ref().expect("a feature report");
+    let f = &report.features;
     assert!(
         f.feature_error[0] <= 1e-9 && f.feature_error[1] <= 1e-9,
         "features off their partners: {:?}",
@@ -67,7 +67,7 @@ fn check_mapped(s: &Mesh, t: &Mesh, sp: &JobSpec) -> (MapReport, f64, Mesh) {
     );
     assert_eq!(f.domain_flips, [0, 0]);
     assert_eq!(f.doubled_genus, f.curves - 1);
-    assert_eq!((report.source_to_target.flipped_faces, report.target_to_source.flipped_faces), (0, 0));
+    assert_eq!((report.pair.source_to_target.flipped_faces, report.pair.target_to_source.flipped_faces), (0, 0));
     let mapped = common::source_on_target(&arts, s, t);
     let gt =
         mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(i as u32))).norm()).sum::<f64>()
@@ -82,7 +82,7 @@ fn a_hand_with_four_features_and_its_wrist_maps_onto_a_bent_copy() {
     let t = bent(&s);
     let c = features(&s, 4);
     let (r, gt) = check(&s, &t, &spec(&c, vec![]));
-    let f = r.features.unwrap();
+    let f = r.features;
     assert_eq!(f.curves, 5, "four features and the wrist");
     assert!(f.word.contains("B5"), "{}", f.word);
     assert!(gt < 0.1, "gt {gt}");
@@ -94,7 +94,7 @@ fn a_closed_bunny_with_three_features_maps_onto_a_twisted_copy() {
     let t = twisted(&s);
     let c = features(&s, 3);
     let (r, gt) = check(&s, &t, &spec(&c, vec![]));
-    assert_eq!(r.features.unwrap().doubled_genus, 2);
+    assert_eq!(r.features.doubled_genus, 2);
     assert!(gt < 0.1, "gt {gt}");
 }
 
@@ -138,7 +138,7 @@ fn feature_jobs_build_the_meta_mesh() {
     let mut sp = spec(&features(&s, 4), vec![]);
     sp.options.meta_mesh = true;
     let (r, arts) = run_map(&sp, &s, &t, &mut NoProgress).unwrap();
-    let stats = r.features.as_ref().unwrap().meta_mesh.clone().expect("meta-mesh statistics");
+    let stats = r.features.meta_mesh.clone().expect("meta-mesh statistics");
     assert!(stats.error.is_none() && stats.crossings > 0, "{stats:?}");
     common::meta_pair(&arts, &s, &t, "hand bent", false);
 
@@ -148,7 +148,7 @@ fn feature_jobs_build_the_meta_mesh() {
     sp.options.meta_mesh = true;
     sp.options.dihedral_threshold_deg = Some(10.0);
     let (r, arts) = run_map(&sp, &a, &b, &mut NoProgress).unwrap();
-    let stats = r.features.as_ref().unwrap().meta_mesh.clone().expect("meta-mesh statistics");
+    let stats = r.features.meta_mesh.clone().expect("meta-mesh statistics");
     assert!(stats.error.is_none() && stats.pruned_vertices.is_some_and(|p| p > 0), "{stats:?}");
     common::meta_pair(&arts, &a, &b, "face / hand, pruned at 10°", true);
 }
@@ -207,15 +207,15 @@ fn two_heads_with_anatomical_features_map_without_folds() {
         0.012,
     );
     let (r, arts) = run_map(&spec_pairs(ca.iter().zip(&cb), vec![]), &a, &b, &mut NoProgress).unwrap();
-    let f = r.features.as_ref().expect("a feature report");
+    let f = &r.features;
     assert_eq!(f.curves, 5, "four features and the neck: {}", f.word);
     assert!(f.word.contains("B5"), "{}", f.word);
     assert!(f.feature_error[0] <= 1e-9 && f.feature_error[1] <= 1e-9, "{:?}", f.feature_error);
     assert_eq!(f.domain_flips, [0, 0]);
-    assert_eq!((r.source_to_target.flipped_faces, r.target_to_source.flipped_faces), (0, 0));
+    assert_eq!((r.pair.source_to_target.flipped_faces, r.pair.target_to_source.flipped_faces), (0, 0));
     let mapped = common::source_on_target(&arts, &a, &b);
     assert_eq!(mapped.faces(), a.faces());
-    assert!(r.source_to_target.off_surface_max <= 1e-9 && r.target_to_source.off_surface_max <= 1e-9);
+    assert!(r.pair.source_to_target.off_surface_max <= 1e-9 && r.pair.target_to_source.off_surface_max <= 1e-9);
 }
 
 #[test]
@@ -234,8 +234,8 @@ fn bad_curves_and_unsupported_topologies_are_refused() {
     let closed = load("bunny.off");
     let e = run_map(&spec(&[], vec![[0, 0]]), &closed, &closed, &mut NoProgress).unwrap_err();
     assert_eq!(e.code(), "topology_mismatch", "{e}");
-    let mut sp = spec(&features(&closed, 1), vec![]);
-    sp.method = Method::Voronoi;
-    let e = run_map(&sp, &closed, &closed, &mut NoProgress).unwrap_err();
-    assert_eq!(e.code(), "invalid_features", "{e}");
+    // Only `homology` takes feature curves: on another method they are an unknown field.
+    let text = br#"{"method": "voronoi", "anchors": [[0, 0], [1, 1], [2, 2]], "features": [{"source": [0, 1], "target": [0, 1]}]}"#;
+    let e = geom::pipeline::JobSpec::from_json(text).unwrap_err();
+    assert_eq!(e.code(), "invalid_spec", "{e}");
 }

@@ -6,7 +6,8 @@
 //! classes (other H1 matrices) and still carry every feature onto its partner.
 
 use geom::mesh::{Mesh, VertexId};
-use geom::pipeline::{FeatureSpec, JobSpec, MapOptions, MapReport, Method, run_map};
+use geom::pipeline::features::run as run_map;
+use geom::pipeline::{FeatureSpec, HomologyOptions, HomologySpec, features::FeatureMapReport};
 use geom::progress::NoProgress;
 
 mod common;
@@ -26,7 +27,7 @@ fn far_from(m: &Mesh, curves: &[Vec<VertexId>]) -> VertexId {
 }
 
 struct Run {
-    report: MapReport,
+    report: FeatureMapReport,
     gt_mean: f64,
 }
 
@@ -41,11 +42,10 @@ fn carried(c: &[Vec<VertexId>], gt: &[u32]) -> Vec<Vec<VertexId>> {
 }
 
 /// The job: base anchor farthest from the curves (and its partner), the curve pairs, `options`.
-fn job(s: &Mesh, gt: &[u32], (c, tc): (&[Vec<VertexId>], &[Vec<VertexId>]), options: MapOptions) -> JobSpec {
+fn job(s: &Mesh, gt: &[u32], (c, tc): (&[Vec<VertexId>], &[Vec<VertexId>]), options: HomologyOptions) -> HomologySpec {
     let base = far_from(s, c);
     let raw = |p: &[VertexId]| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
-    JobSpec {
-        method: Method::Homology,
+    HomologySpec {
         anchors: vec![[base.0 as u64, gt[base.idx()] as u64]],
         features: c.iter().zip(tc).map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) }).collect(),
         options,
@@ -61,17 +61,17 @@ fn run_with(
     basis: [usize; 2],
     rotation: usize,
 ) -> Run {
-    let sp = job(s, gt, (c, tc), MapOptions { metric_samples: 5000, basis, rotation, ..Default::default() });
+    let sp = job(s, gt, (c, tc), HomologyOptions { metric_samples: 5000, basis, rotation, ..Default::default() });
     let (report, arts) = run_map(&sp, s, t, &mut NoProgress).unwrap();
     common::assert_artifacts(
         &arts,
         &["basis_source.json", "basis_target.json", "domain_source.obj", "domain_target.obj", "morph.glb"],
     );
-    let f = report.features.as_ref().expect("a feature report");
+    let f = &report.features;
     assert!(f.feature_error[0] <= 1e-9 && f.feature_error[1] <= 1e-9, "features off: {:?}", f.feature_error);
     assert_eq!(f.domain_flips, [0, 0]);
     assert_eq!(f.doubled_genus, 2 * f.genus + c.len() - 1);
-    for m in [&report.source_to_target, &report.target_to_source] {
+    for m in [&report.pair.source_to_target, &report.pair.target_to_source] {
         assert!(m.anchor_error_max.unwrap() <= 1e-9, "anchor {m:?}");
     }
     let mapped = common::source_on_target(&arts, s, t);
@@ -83,12 +83,12 @@ fn run_with(
 }
 
 fn clean(r: &Run) -> bool {
-    let m = [&r.report.source_to_target, &r.report.target_to_source];
+    let m = [&r.report.pair.source_to_target, &r.report.pair.target_to_source];
     m.iter().all(|m| m.flipped_faces == 0 && (0.97..=1.03).contains(&m.area_ratio)) && r.gt_mean <= 0.05
 }
 
 fn h1(r: &Run) -> Vec<Vec<i32>> {
-    r.report.features.as_ref().unwrap().h1.clone().expect("an H1 matrix")
+    r.report.features.h1.clone().expect("an H1 matrix")
 }
 
 /// The first class (basis pair, then rotation) that is clean: a deformation can change which
@@ -114,9 +114,9 @@ fn kitten_with_four_features_on_a_twisted_copy_genus_one() {
     let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
     let c = curves(&s, 4);
     let r = run(&s, &t, &gt, &c, [0, 0], 0);
-    assert!(clean(&r), "gt {} {:?}", r.gt_mean, r.report.source_to_target);
+    assert!(clean(&r), "gt {} {:?}", r.gt_mean, r.report.pair.source_to_target);
     assert_eq!(h1(&r), vec![vec![1, 0], vec![0, 1]]);
-    let f = r.report.features.as_ref().unwrap();
+    let f = &r.report.features;
     assert_eq!((f.genus, f.doubled_genus, f.curves), (1, 5, 4));
     assert!(f.word.contains("L4 a1 b1 a1^-1 b1^-1 L4^-1"), "{}", f.word);
 }
@@ -131,7 +131,7 @@ fn kitten_with_three_features_on_another_triangulation_genus_one() {
     let c = curves(&s, 3);
     let tc: Vec<Vec<VertexId>> = c.iter().map(|p| path_on_subdivided(&s, &t, p)).collect();
     let r = run_with(&s, &t, &gt, (&c, &tc), [0, 0], 0);
-    assert!(clean(&r), "gt {} {:?}", r.gt_mean, r.report.source_to_target);
+    assert!(clean(&r), "gt {} {:?}", r.gt_mean, r.report.pair.source_to_target);
 }
 
 #[test]
@@ -154,7 +154,7 @@ fn eight_with_three_features_on_a_bent_copy_genus_two() {
     let t = bent(&s);
     let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
     let (r, basis, rot) = first_clean(&s, &t, &gt, &curves(&s, 3), 2);
-    let f = r.report.features.as_ref().unwrap();
+    let f = &r.report.features;
     assert_eq!((f.genus, f.doubled_genus), (2, 6));
     // The other rotation of that basis pair is another class.
     let other = run(&s, &t, &gt, &curves(&s, 3), basis, rot + 1);
@@ -168,12 +168,12 @@ fn three_holes_with_four_features_on_a_shuffled_copy_genus_three_with_meta_mesh(
     let c = curves(&s, 4);
     let r = run(&s, &t, &gt, &c, [0, 0], 0);
     assert!(clean(&r) && r.gt_mean < 1e-9, "gt {}", r.gt_mean);
-    assert_eq!(r.report.features.as_ref().unwrap().doubled_genus, 9);
+    assert_eq!(r.report.features.doubled_genus, 9);
     // The meta-mesh of the pair: one face list, χ of genus 3, every vertex on its surface.
-    let options = MapOptions { metric_samples: 2000, meta_mesh: true, ..Default::default() };
+    let options = HomologyOptions { metric_samples: 2000, meta_mesh: true, ..Default::default() };
     let sp = job(&s, &gt, (&c, &carried(&c, &gt)), options);
     let (rep, arts) = run_map(&sp, &s, &t, &mut NoProgress).unwrap();
-    let stats = rep.features.unwrap().meta_mesh.expect("meta-mesh statistics");
+    let stats = rep.features.meta_mesh.expect("meta-mesh statistics");
     assert!(stats.error.is_none(), "{stats:?}");
     common::meta_pair(&arts, &s, &t, "3holes shuffled", false);
 }
@@ -182,14 +182,13 @@ fn three_holes_with_four_features_on_a_shuffled_copy_genus_three_with_meta_mesh(
 fn a_base_on_a_feature_or_boundary_with_handles_is_refused() {
     let s = load("torus.obj");
     let c = curves(&s, 1);
-    let sp = |anchors: Vec<[u64; 2]>| JobSpec {
-        method: Method::Homology,
+    let sp = |anchors: Vec<[u64; 2]>| HomologySpec {
         anchors,
         features: vec![FeatureSpec {
             source: c[0].iter().map(|v| v.0 as u64).collect(),
             target: c[0].iter().map(|v| v.0 as u64).collect(),
         }],
-        options: MapOptions::default(),
+        options: HomologyOptions::default(),
     };
     let on = c[0][1].0 as u64;
     let e = run_map(&sp(vec![[on, on]]), &s, &s, &mut NoProgress).unwrap_err();

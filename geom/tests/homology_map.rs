@@ -3,14 +3,16 @@
 //! and a small ground-truth error; other rotations give other H1 matrices.
 
 use geom::mesh::{Mesh, VertexId};
-use geom::pipeline::{JobSpec, MapOptions, MapReport, Method, run_map};
+use geom::pipeline::homology::HomologyMapReport;
+use geom::pipeline::homology::run as run_map;
+use geom::pipeline::{HomologyOptions, HomologySpec};
 use geom::progress::NoProgress;
 
 mod common;
 use common::{bent, load, shuffled, subdivided};
 
 struct Run {
-    report: MapReport,
+    report: HomologyMapReport,
     gt_mean: f64,
 }
 
@@ -20,11 +22,10 @@ fn run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, basis: 
 
 /// `None` when this basis pair does not exist (a later basis index may need more room).
 fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, basis: [usize; 2]) -> Option<Run> {
-    let spec = JobSpec {
-        method: Method::Homology,
+    let spec = HomologySpec {
         features: Vec::new(),
         anchors: anchors.iter().map(|&a| [a as u64, gt[a as usize] as u64]).collect(),
-        options: MapOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
+        options: HomologyOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
     };
     let (report, arts) = match run_map(&spec, s, t, &mut NoProgress) {
         Ok(x) => x,
@@ -55,7 +56,7 @@ fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, bas
 }
 
 fn assert_clean(r: &Run, what: &str) {
-    for m in [&r.report.source_to_target, &r.report.target_to_source] {
+    for m in [&r.report.pair.source_to_target, &r.report.pair.target_to_source] {
         assert_eq!(m.flipped_faces, 0, "{what}: flips {m:?}");
         assert!(m.anchor_error_max.unwrap() <= 1e-9, "{what}: anchors {m:?}");
         assert!((0.97..=1.03).contains(&m.area_ratio), "{what}: area {m:?}");
@@ -64,7 +65,7 @@ fn assert_clean(r: &Run, what: &str) {
 }
 
 fn h1(r: &Run) -> Vec<Vec<i32>> {
-    r.report.homology.as_ref().unwrap().h1.clone()
+    r.report.homology.h1.clone()
 }
 
 #[test]
@@ -112,8 +113,9 @@ fn first_clean(s: &Mesh, t: &Mesh, gt: &[u32], g: usize) -> (Run, usize) {
             for rot in 0..g {
                 tried += 1;
                 let Some(r) = try_run(s, t, gt, &[0], rot, [bs, bt]) else { continue };
-                let clean =
-                    [&r.report.source_to_target, &r.report.target_to_source].iter().all(|m| m.flipped_faces == 0);
+                let clean = [&r.report.pair.source_to_target, &r.report.pair.target_to_source]
+                    .iter()
+                    .all(|m| m.flipped_faces == 0);
                 if clean && r.gt_mean <= 0.05 {
                     return (r, tried);
                 }
@@ -130,9 +132,9 @@ fn three_holes_bent_genus_three() {
     let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
     let (r, _) = first_clean(&s, &t, &gt, 3);
     assert_clean(&r, "3holes bent");
-    assert_eq!(r.report.homology.as_ref().unwrap().genus, 3);
+    assert_eq!(r.report.homology.genus, 3);
     // The rotations of that basis pair are other classes: other H1 matrices.
-    let h = r.report.homology.as_ref().unwrap();
+    let h = r.report.homology;
     let others: Vec<_> = (1..3).map(|k| h1(&run(&s, &t, &gt, &[0], (h.rotation + k) % 3, h.basis))).collect();
     assert!(others.iter().all(|o| *o != h.h1) && others[0] != others[1]);
 }
@@ -152,18 +154,17 @@ fn another_triangulation_genus_one_and_two() {
     let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
     let (r, _) = first_clean(&s, &t, &gt, 2);
     assert_clean(&r, "eight_lowres subdivided");
-    let h = r.report.homology.as_ref().unwrap();
+    let h = r.report.homology;
     assert_ne!(h1(&run(&s, &t, &gt, &[0], h.rotation + 1, h.basis)), h.h1);
 }
 
 /// The meta-mesh pair (pruned below `prune` degrees if given): one face list, every vertex on
 /// its own surface, the surfaces' topology. Returns the face count.
 fn check_meta(s: &Mesh, t: &Mesh, anchors: &[[u64; 2]], what: &str, prune: Option<f64>) -> usize {
-    let spec = JobSpec {
-        method: Method::Homology,
+    let spec = HomologySpec {
         features: Vec::new(),
         anchors: anchors.to_vec(),
-        options: MapOptions {
+        options: HomologyOptions {
             metric_samples: 2000,
             meta_mesh: true,
             dihedral_threshold_deg: prune,
@@ -171,7 +172,7 @@ fn check_meta(s: &Mesh, t: &Mesh, anchors: &[[u64; 2]], what: &str, prune: Optio
         },
     };
     let (report, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();
-    let stats = report.homology.as_ref().unwrap().meta_mesh.clone().unwrap();
+    let stats = report.homology.meta_mesh.clone().unwrap();
     assert!(stats.error.is_none(), "{what}: {stats:?}");
     assert_eq!(stats.pruned_vertices.is_some(), prune.is_some());
     let (ms, _) = common::meta_pair(&arts, s, t, what, prune.is_some());
@@ -195,24 +196,23 @@ fn meta_mesh_kitten_bent_and_torus_pair() {
 fn a_curve_matching_selects_its_class() {
     let s = load("torus.obj");
     let (t, gt) = shuffled(&s);
-    let job = |m: &[&str]| JobSpec {
-        method: Method::Homology,
+    let job = |m: &[&str]| HomologySpec {
         features: Vec::new(),
         anchors: vec![[0, gt[0] as u64]],
-        options: MapOptions {
+        options: HomologyOptions {
             metric_samples: 2000,
             matching: Some(m.iter().map(|x| x.to_string()).collect()),
             ..Default::default()
         },
     };
     let (r, _) = run_map(&job(&["a1 -> a1", "b1 -> b1"]), &s, &t, &mut NoProgress).unwrap();
-    assert_eq!(r.homology.unwrap().h1_reference, Some(vec![vec![1, 0], vec![0, 1]]));
+    assert_eq!(r.homology.h1_reference, Some(vec![vec![1, 0], vec![0, 1]]));
     let (r, _) = run_map(&job(&["a1 -> b1", "b1 -> -a1"]), &s, &t, &mut NoProgress).unwrap();
-    let h = r.homology.unwrap();
+    let h = r.homology;
     assert_eq!(h.h1_reference, Some(vec![vec![0, -1], vec![1, 0]]));
     // A Dehn twist: a basis pair whose first loops lie in different classes realizes it.
     let (r, _) = run_map(&job(&["a1 -> a1+b1", "b1 -> b1"]), &s, &t, &mut NoProgress).unwrap();
-    let h = r.homology.unwrap();
+    let h = r.homology;
     assert_eq!(h.h1_reference, Some(vec![vec![1, 0], vec![1, 1]]));
     assert_ne!(h.basis[0], h.basis[1]);
     // Orientation-reversing swaps are refused before any work.

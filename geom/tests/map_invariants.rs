@@ -6,7 +6,8 @@ use geom::io::ReadOptions;
 mod common;
 use common::{fps, load, shuffled, twisted};
 use geom::mesh::{Mesh, VertexId};
-use geom::pipeline::{JobSpec, MapOptions, Method, run_map};
+use geom::pipeline::voronoi::run as run_layout;
+use geom::pipeline::{LayoutSpec, MapOptions, Method};
 use geom::progress::NoProgress;
 use geom::topology::Locator;
 
@@ -43,13 +44,8 @@ fn check_with(
     area: std::ops::RangeInclusive<f64>,
 ) -> Checked {
     let anchors: Vec<[u64; 2]> = fps(s, k).into_iter().map(|a| [a as u64, gt[a as usize] as u64]).collect();
-    let spec = JobSpec {
-        method,
-        anchors: anchors.clone(),
-        features: Vec::new(),
-        options: MapOptions { metric_samples: 5000, ..options },
-    };
-    let (rep, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();
+    let spec = LayoutSpec { anchors: anchors.clone(), options: MapOptions { metric_samples: 5000, ..options } };
+    let (rep, arts) = run_layout(method, &spec, s, t, &mut NoProgress).unwrap();
     let names: Vec<&str> = arts.iter().map(|a| a.name.as_str()).collect();
     for n in [
         "source_on_target.obj",
@@ -66,7 +62,7 @@ fn check_with(
     // Patches of a cellular triangulation of a closed surface: F = 2 (V - χ).
     let chi = geom::topology::euler_characteristic(s);
     assert_eq!(rep.patches as i64, 2 * (k as i64 - chi));
-    for (m, a) in [(&rep.source_to_target, s), (&rep.target_to_source, t)] {
+    for (m, a) in [(&rep.pair.source_to_target, s), (&rep.pair.target_to_source, t)] {
         assert_eq!(m.flipped_faces, 0, "flips {m:?}");
         assert!(m.anchor_error_max.unwrap() <= 1e-9, "anchors {m:?}");
         assert!(area.contains(&m.area_ratio), "area {m:?}");
@@ -86,11 +82,11 @@ fn check_with(
             / mapped.n_vertices() as f64
             / t.area().sqrt();
     Checked {
-        l2: rep.source_to_target.l2_stretch,
-        l2_back: rep.target_to_source.l2_stretch,
-        repaired: rep.smoothing.repaired,
+        l2: rep.pair.source_to_target.l2_stretch,
+        l2_back: rep.pair.target_to_source.l2_stretch,
+        repaired: rep.pair.smoothing.repaired,
         gt_mean,
-        reembedded: rep.smoothing.reembedded,
+        reembedded: rep.pair.smoothing.reembedded,
         fallback: rep.layout.fallback,
         global_used: rep.global.as_ref().is_some_and(|g| g.used),
         global_fallback: rep.global.as_ref().and_then(|g| g.fallback.clone()),

@@ -8,13 +8,17 @@ mod common;
 
 use common::{bent, fps, load};
 use geom::Mesh;
-use geom::pipeline::{Artifact, RemeshSpec, run_remesh};
+use geom::pipeline::quad::run as run_remesh;
+use geom::pipeline::{Artifact, JobSpec, QuadSpec};
 use geom::progress::NoProgress;
 use geom::topology::summary;
 use serde_json::json;
 
-fn spec(v: serde_json::Value) -> RemeshSpec {
-    RemeshSpec::from_json(&serde_json::to_vec(&v).unwrap()).expect("spec")
+fn spec(v: serde_json::Value) -> QuadSpec {
+    match JobSpec::from_json(&serde_json::to_vec(&v).unwrap()).expect("spec") {
+        JobSpec::Quad(q) => q,
+        other => panic!("not a quad spec: {other:?}"),
+    }
 }
 
 fn artifact<'a>(arts: &'a [Artifact], name: &str) -> &'a [u8] {
@@ -189,7 +193,7 @@ fn bad_quad_jobs_get_typed_errors() {
         assert_eq!(e.code(), code, "{v}: {e}");
         assert!(e.is_input());
     }
-    assert!(RemeshSpec::from_json(br#"{"method": "voronoi", "anchors": []}"#).is_err());
+    assert!(!matches!(JobSpec::from_json(br#"{"method": "voronoi", "anchors": []}"#), Ok(JobSpec::Quad(_))));
 }
 
 #[test]

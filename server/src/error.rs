@@ -52,7 +52,9 @@ impl ApiError {
 impl From<geom::Error> for ApiError {
     fn from(e: geom::Error) -> ApiError {
         match &e {
-            geom::Error::Input(geom::InputError::Spec(_)) => Self::bad_request(e.code(), e.to_string()),
+            geom::Error::Input(geom::InputError::Spec(_) | geom::InputError::UnknownMethod(_)) => {
+                Self::bad_request(e.code(), e.to_string())
+            }
             geom::Error::Input(geom::InputError::TooLarge { .. }) => {
                 Self::new(StatusCode::PAYLOAD_TOO_LARGE, e.code(), e.to_string())
             }

@@ -73,7 +73,11 @@ impl Surfmap for GrpcApi {
         let r = req.into_inner();
         let key = Some(r.idempotency_key).filter(|k| !k.is_empty());
         let meshes = if r.meshes.is_empty() { vec![r.source, r.target] } else { r.meshes };
-        let (j, _) = self.state.service.submit(&o, &meshes, r.spec_json.as_bytes(), key).await?;
+        let (j, _) = self
+            .state
+            .service
+            .submit(&o, &meshes, crate::service::SpecInput::Bytes(r.spec_json.into_bytes()), key)
+            .await?;
         Ok(Response::new(job(&j)))
     }
 

@@ -6,7 +6,7 @@ use crate::views::MeshView;
 use futures::Stream;
 use geom::io::{Format, ReadOptions};
 use geom::mesh::MeshLimits;
-use geom::pipeline::Job;
+use geom::pipeline::JobSpec;
 use std::time::Duration;
 use surfmap_store::{ArtifactRef, BlobStore, JobFilter, JobRecord, JobState, MeshRecord, NewJob, Store, now_ms};
 
@@ -131,24 +131,11 @@ pub fn job_filter(state: &str, method: &str, cursor: &str, limit: i64) -> Result
     Ok(JobFilter { state, method: some(method), before: some(cursor), limit })
 }
 
-/// Parses a spec, naming an unknown method before any other field.
-///
-/// # Errors
-/// `unknown_method` or `invalid_spec` (400).
-pub fn parse_spec(bytes: &[u8]) -> Result<Job, ApiError> {
-    let v: serde_json::Value = serde_json::from_slice(bytes)
-        .map_err(|e| ApiError::bad_request("invalid_spec", format!("spec is not JSON: {e}")))?;
-    match v.get("method") {
-        Some(serde_json::Value::String(m)) if !METHODS.contains(&m.as_str()) => {
-            return Err(ApiError::bad_request(
-                "unknown_method",
-                format!("unknown method {m:?}; available: {}", METHODS.join(", ")),
-            ));
-        }
-        None => return Err(ApiError::bad_request("invalid_spec", "spec has no \"method\"")),
-        _ => {}
-    }
-    Ok(Job::from_json(bytes)?)
+/// A job's spec as it arrived: bytes (a multipart part, gRPC `spec_json`) or a JSON value
+/// inside a REST body already read under the JSON limit.
+pub enum SpecInput {
+    Bytes(Vec<u8>),
+    Json(serde_json::Value),
 }
 
 impl JobService {
@@ -207,7 +194,7 @@ impl JobService {
         &self,
         owner: &str,
         meshes: &[String],
-        spec: &[u8],
+        spec: SpecInput,
         idempotency_key: Option<String>,
     ) -> Result<(JobRecord, bool), ApiError> {
         if meshes.is_empty() || meshes.len() > geom::pipeline::MAX_MODELS {
@@ -227,14 +214,17 @@ impl JobService {
         }
         // The meshes first (404), then the spec: bounded (REST JSON bodies are bounded before
         // they are read; this covers multipart parts and gRPC), parsed once, here.
-        if spec.len() > self.limits.max_json_bytes {
-            return Err(ApiError::too_large(format!(
-                "the spec of {} bytes exceeds the limit of {} for JSON",
-                spec.len(),
-                self.limits.max_json_bytes
-            )));
-        }
-        let job = &parse_spec(spec)?;
+        let job = &match spec {
+            SpecInput::Bytes(b) if b.len() > self.limits.max_json_bytes => {
+                return Err(ApiError::too_large(format!(
+                    "the spec of {} bytes exceeds the limit of {} for JSON",
+                    b.len(),
+                    self.limits.max_json_bytes
+                )));
+            }
+            SpecInput::Bytes(b) => JobSpec::from_json(&b)?,
+            SpecInput::Json(v) => JobSpec::from_value(v)?,
+        };
         job.check(&summaries)?;
         let estimate = job.memory_estimate(&summaries);
         if estimate > self.limits.job_memory_bytes {
@@ -244,20 +234,13 @@ impl JobService {
             })
             .into());
         }
-        let method = job.method();
-        let spec = match job {
-            Job::Map(_) => job.to_json()?,
-            Job::Remesh(s) => {
-                serde_json::to_string(&serde_json::json!({"meshes": meshes, "spec": s})).map_err(ApiError::internal)?
-            }
-        };
+        let method = job.method().name();
         let new = NewJob {
             owner: owner.to_string(),
             idempotency_key: idempotency_key.filter(|k| !k.is_empty()),
             method: method.to_string(),
-            spec,
-            source: meshes[0].clone(),
-            target: meshes[meshes.len() - 1].clone(),
+            spec: job.to_json()?,
+            meshes: meshes.to_vec(),
             max_attempts: self.limits.max_attempts,
         };
         let r = self.store.insert_job(&new).await?;

@@ -50,6 +50,9 @@ pub struct JobView {
     pub attempts: i64,
     pub max_attempts: i64,
     pub method: String,
+    /// The job's meshes in the spec's order (source, target for a pair job).
+    pub meshes: Vec<String>,
+    /// The first and the last of `meshes`.
     pub source: String,
     pub target: String,
     pub cancel_requested: bool,
@@ -90,8 +93,8 @@ pub struct SubmitJob {
     pub source: Option<String>,
     #[serde(default)]
     pub target: Option<String>,
-    /// Mesh ids of an N-mesh job (`quad`), in the order of the spec's anchor columns; instead
-    /// of `source` and `target`.
+    /// Mesh ids in the order of the spec's anchor columns (source, target for a pair job);
+    /// instead of `source` and `target`.
     #[serde(default)]
     #[schema(min_items = 1, max_items = 16)]
     pub meshes: Option<Vec<String>>,
@@ -123,12 +126,13 @@ pub struct PairJobRequest {
     spec: serde_json::Value,
 }
 
-/// An N-mesh job (`quad`).
+/// A job on a list of meshes: any method (`quad` takes 1 to 16; pair methods take source,
+/// target).
 #[derive(Debug, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 #[allow(dead_code)]
 pub struct MeshesJobRequest {
-    /// Mesh ids in the order of the spec's anchor columns.
+    /// Mesh ids in the order of the spec's anchor columns (source, target for a pair job).
     #[schema(min_items = 1, max_items = 16)]
     meshes: Vec<String>,
     #[schema(value_type = SpecOutline)]
@@ -173,6 +177,7 @@ pub fn job_view(j: &JobRecord) -> JobView {
         attempts: j.attempts,
         max_attempts: j.max_attempts,
         method: j.method.clone(),
+        meshes: j.meshes.clone(),
         source: j.source.clone(),
         target: j.target.clone(),
         cancel_requested: j.cancel_requested,

@@ -286,6 +286,7 @@ async fn quad_job_over_three_meshes_through_the_queue() {
     assert_eq!(st, StatusCode::ACCEPTED, "{}", String::from_utf8_lossy(&job));
     let job: Value = serde_json::from_slice(&job).unwrap();
     assert_eq!(job["method"], "quad");
+    assert_eq!(job["meshes"], json!(ids), "one job shape: the meshes in the spec's order");
     let id = job["id"].as_str().unwrap().to_string();
     let (_tx, rx) = tokio::sync::watch::channel(false);
     assert_eq!(t.worker.run_once(&rx).await.unwrap(), Ran::Ran { job: id.clone(), outcome: "succeeded".into() });
@@ -356,7 +357,9 @@ async fn spec_bombs_nested_unknown_fields_and_budget_are_refused_at_submission()
         ),
         (json!({"metric_samples": 1_000_000_000_000u64}), 422, "option_out_of_range", "metric_samples"),
         (json!({"smoothing": {"iterations": 1u64 << 40}}), 422, "option_out_of_range", "smoothing.iterations"),
-        (json!({"untangle": {"max_rings": 100_000}}), 422, "option_out_of_range", "untangle.max_rings"),
+        (json!({"smoothing": {"tolerance": 2.0}}), 422, "option_out_of_range", "smoothing.tolerance"),
+        (json!({"untangle": {"max_rings": 10}}), 400, "invalid_spec", "untangle"),
+        (json!({"basis": [0, 0]}), 400, "invalid_spec", "basis"),
         (json!({"layout": {"bogus": 1}}), 400, "invalid_spec", "bogus"),
         (json!({"smoothing": {"bogus": 1}}), 400, "invalid_spec", "bogus"),
         (json!({"layout": {"flip": {"bogus": 1}}}), 400, "invalid_spec", "bogus"),

@@ -72,8 +72,11 @@ pub struct JobRecord {
     pub owner: String,
     pub idempotency_key: Option<String>,
     pub method: String,
-    /// JSON of the resolved `JobSpec`.
+    /// JSON of the typed `JobSpec` (`geom::pipeline::JobSpec::to_json`).
     pub spec: String,
+    /// Mesh ids in the spec's order (source, target for a pair job).
+    pub meshes: Vec<String>,
+    /// The first and the last mesh.
     pub source: String,
     pub target: String,
     pub state: JobState,
@@ -103,9 +106,10 @@ pub struct NewJob {
     pub owner: String,
     pub idempotency_key: Option<String>,
     pub method: String,
+    /// JSON of the typed `JobSpec`.
     pub spec: String,
-    pub source: String,
-    pub target: String,
+    /// Mesh ids in the spec's order (source, target for a pair job).
+    pub meshes: Vec<String>,
     pub max_attempts: i64,
 }
 

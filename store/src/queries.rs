@@ -44,6 +44,10 @@ macro_rules! job_from_row {
             idempotency_key: r.try_get("idempotency_key")?,
             method: r.try_get("method")?,
             spec: r.try_get("spec")?,
+            meshes: {
+                let m: String = r.try_get("meshes")?;
+                serde_json::from_str(&m).map_err(|e| StoreError::Corrupt(format!("meshes: {e}")))?
+            },
             source: r.try_get("source")?,
             target: r.try_get("target")?,
             state: JobState::parse(&state).ok_or_else(|| StoreError::Corrupt(format!("job state {state:?}")))?,
@@ -170,15 +174,17 @@ impl Store {
     pub async fn insert_job(&self, j: &NewJob) -> Result<(JobRecord, bool)> {
         let id = uuid::Uuid::now_v7().to_string();
         let now = now_ms();
-        let hash = crate::blobs::sha256_hex(
-            format!("{}\n{}\n{}\n{}\n{}", j.method, j.source, j.target, j.max_attempts, j.spec).as_bytes(),
-        );
+        let meshes = serde_json::to_string(&j.meshes).map_err(|e| StoreError::Corrupt(e.to_string()))?;
+        let hash =
+            crate::blobs::sha256_hex(format!("{}\n{meshes}\n{}\n{}", j.method, j.max_attempts, j.spec).as_bytes());
+        let (source, target) =
+            (j.meshes.first().cloned().unwrap_or_default(), j.meshes.last().cloned().unwrap_or_default());
         let inserted = on!(self, p => sqlx::query(
-            "INSERT INTO jobs (id, owner, idempotency_key, request_hash, method, spec, source, target, state, \
-             max_attempts, created_at, updated_at) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, 'queued', $9, $10, $10) \
+            "INSERT INTO jobs (id, owner, idempotency_key, request_hash, method, spec, meshes, source, target, state, \
+             max_attempts, created_at, updated_at) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, 'queued', $10, $11, $11) \
              ON CONFLICT (owner, idempotency_key) DO NOTHING")
             .bind(&id).bind(&j.owner).bind(&j.idempotency_key).bind(&hash).bind(&j.method).bind(&j.spec)
-            .bind(&j.source).bind(&j.target).bind(j.max_attempts).bind(now)
+            .bind(&meshes).bind(&source).bind(&target).bind(j.max_attempts).bind(now)
             .execute(p).await?.rows_affected());
         if inserted == 1 {
             let job =

@@ -22,8 +22,7 @@ fn job(key: Option<&str>, spec: &str) -> NewJob {
         idempotency_key: key.map(str::to_string),
         method: "voronoi".into(),
         spec: spec.into(),
-        source: "s".repeat(64),
-        target: "t".repeat(64),
+        meshes: vec!["s".repeat(64), "t".repeat(64)],
         max_attempts: 2,
     }
 }

@@ -145,7 +145,7 @@ async fn the_job_process_aborts_above_its_memory_cap() {
         )
         .unwrap();
     }
-    let job = serde_json::json!({"job": spec.to_string(), "meshes": 2, "max_vertices": 2_000_000, "memory_bytes": 400u64 << 20});
+    let job = serde_json::json!({"job": spec, "meshes": 2, "max_vertices": 2_000_000, "memory_bytes": 400u64 << 20});
     std::fs::write(dir.path().join("job.json"), job.to_string()).unwrap();
     // The child exits when its stdin closes, so the test holds the pipe open until it ends.
     let mut child = std::process::Command::new(common::binary("surfmap-worker"))

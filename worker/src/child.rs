@@ -15,7 +15,7 @@
 
 use geom::io::ReadOptions;
 use geom::mesh::MeshLimits;
-use geom::pipeline::Job;
+use geom::pipeline::JobSpec;
 use geom::progress::Stage;
 use serde::{Deserialize, Serialize};
 use std::io::{Read, Write};
@@ -27,8 +27,8 @@ pub const CHILD_ARG: &str = "__run-job";
 /// What the worker hands the child in `job.json`.
 #[derive(Debug, Serialize, Deserialize)]
 pub(crate) struct ChildInput {
-    /// The job's typed spec ([`Job::to_json`]).
-    pub job: String,
+    /// The job's typed spec.
+    pub job: JobSpec,
     pub meshes: usize,
     pub max_vertices: u64,
     /// Address-space limit of the child in bytes (0: none).
@@ -45,17 +45,8 @@ pub(crate) struct ChildArtifact {
 /// What the child leaves in `result.json`.
 #[derive(Debug, Serialize, Deserialize)]
 pub(crate) enum ChildOutput {
-    Succeeded {
-        method: String,
-        timings_ms: Vec<(String, f64)>,
-        report: serde_json::Value,
-        artifacts: Vec<ChildArtifact>,
-    },
-    Failed {
-        code: String,
-        message: String,
-        internal: bool,
-    },
+    Succeeded { timings_ms: Vec<(String, f64)>, report: serde_json::Value, artifacts: Vec<ChildArtifact> },
+    Failed { code: String, message: String, internal: bool },
 }
 
 /// Runs one job when `args` are `[exe, CHILD_ARG, DIR]`, then returns the exit code; `None`
@@ -142,7 +133,6 @@ fn run(dir: &Path) -> std::io::Result<()> {
 
 fn execute(dir: &Path, input: &ChildInput) -> geom::Result<ChildOutput> {
     let io = |e: std::io::Error| geom::Error::Internal(format!("job directory: {e}"));
-    let job = Job::from_json(input.job.as_bytes())?;
     let limits = MeshLimits { max_vertices: input.max_vertices, max_faces: 2 * input.max_vertices + 8 };
     let mut meshes = Vec::with_capacity(input.meshes);
     for i in 0..input.meshes {
@@ -150,16 +140,15 @@ fn execute(dir: &Path, input: &ChildInput) -> geom::Result<ChildOutput> {
         meshes.push(geom::io::read(&bytes, &ReadOptions { limits, hint: None })?.mesh);
     }
     let mut progress = StdoutProgress { last: None };
-    let (out, artifacts) = geom::pipeline::run_job(&job, &meshes, &mut progress)?;
+    let (report, artifacts) = geom::pipeline::run_job(&input.job, &meshes, &mut progress)?;
     let mut listed = Vec::with_capacity(artifacts.len());
     for (k, a) in artifacts.into_iter().enumerate() {
         std::fs::write(dir.join(format!("out_{k}")), &a.bytes).map_err(io)?;
         listed.push(ChildArtifact { name: a.name, content_type: a.content_type.to_string() });
     }
     Ok(ChildOutput::Succeeded {
-        method: out.method.to_string(),
-        timings_ms: out.timings_ms,
-        report: out.report,
+        timings_ms: report.timings_ms().to_vec(),
+        report: serde_json::to_value(&report).map_err(|e| geom::Error::Internal(e.to_string()))?,
         artifacts: listed,
     })
 }

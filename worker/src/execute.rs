@@ -5,7 +5,7 @@ use crate::Shutdown;
 use crate::config::WorkerConfig;
 use crate::progress::Shared;
 use crate::running::{Finished, RunError, Running};
-use geom::pipeline::Job;
+use geom::pipeline::JobSpec;
 use std::time::Instant;
 use surfmap_store::{ArtifactRef, BlobStore, Claim, Heartbeat, JobRecord, Outcome, Store, StoreError};
 use tracing::{info, warn};
@@ -76,7 +76,7 @@ impl Worker {
         let started = Instant::now();
         let lease_ms = i64::try_from(self.config.lease.as_millis()).unwrap_or(i64::MAX);
         let shared = Shared::default();
-        let mut running = match self.load(&job.spec, &job.source, &job.target).await {
+        let mut running = match self.load(&job).await {
             Ok((spec, meshes)) => Running::start(&self.config, spec, meshes, &shared).await,
             Err(e) => Err(RunError::Geom(e)),
         };
@@ -87,7 +87,7 @@ impl Worker {
         let stopped = stops.user || stops.lost || stops.timed_out || stops.shutdown;
         let result = match running {
             Ok(run) => match run.collect(stopped).await {
-                Ok(done) => self.store_artifacts(done).await,
+                Ok(done) => self.store_artifacts(&job.method, done).await,
                 Err(e) => Err(e),
             },
             Err(e) => Err(e),
@@ -152,23 +152,12 @@ impl Worker {
         }
     }
 
-    /// Spec and mesh bytes of a job. A pair job stores its spec and its source and target; an
-    /// N-mesh job stores `{"meshes": [id, ...], "spec": {...}}`.
-    async fn load(&self, spec: &str, source: &str, target: &str) -> Result<(Job, Vec<Vec<u8>>), geom::Error> {
-        let stored: serde_json::Value = serde_json::from_str(spec).unwrap_or_default();
-        let ids = stored
-            .get("meshes")
-            .and_then(|m| m.as_array())
-            .map(|a| a.iter().filter_map(|x| x.as_str().map(str::to_string)).collect::<Vec<String>>());
-        let (job, keys) = match (ids, stored.get("spec")) {
-            (Some(ids), Some(inner)) => {
-                let bytes = serde_json::to_vec(inner).map_err(|e| geom::Error::Internal(e.to_string()))?;
-                (Job::from_json(&bytes)?, ids)
-            }
-            _ => (Job::from_json(spec.as_bytes())?, vec![source.to_string(), target.to_string()]),
-        };
+    /// The job's typed spec (stored by the server from the same type) and its meshes' bytes.
+    async fn load(&self, job: &JobRecord) -> Result<(JobSpec, Vec<Vec<u8>>), geom::Error> {
+        let spec = JobSpec::from_json(job.spec.as_bytes())?;
+        let keys = &job.meshes;
         let mut meshes = Vec::with_capacity(keys.len());
-        for key in &keys {
+        for key in keys {
             let bytes = self
                 .blobs
                 .get(key)
@@ -177,10 +166,10 @@ impl Worker {
                 .ok_or_else(|| geom::Error::Internal(format!("mesh blob {key} is missing from the data dir")))?;
             meshes.push(bytes);
         }
-        Ok((job, meshes))
+        Ok((spec, meshes))
     }
 
-    async fn store_artifacts(&self, done: Finished) -> Result<(String, Vec<ArtifactRef>), RunError> {
+    async fn store_artifacts(&self, method: &str, done: Finished) -> Result<(String, Vec<ArtifactRef>), RunError> {
         let internal = |m: String| RunError::Geom(geom::Error::Internal(m));
         let mut refs = Vec::with_capacity(done.artifacts.len());
         for (name, content_type, bytes) in done.artifacts {
@@ -188,7 +177,7 @@ impl Worker {
             refs.push(ArtifactRef { name, content_type, sha256, size: bytes.len() as u64 });
         }
         for (stage, ms) in &done.timings_ms {
-            metrics::histogram!("surfmap_stage_duration_seconds", "method" => done.method.clone(), "stage" => stage.clone())
+            metrics::histogram!("surfmap_stage_duration_seconds", "method" => method.to_string(), "stage" => stage.clone())
                 .record(ms / 1e3);
         }
         let json = serde_json::to_string(&done.report).map_err(|e| internal(e.to_string()))?;

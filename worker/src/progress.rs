@@ -21,8 +21,6 @@ fn span(stage: Stage) -> (f64, f64) {
         Stage::Compose => (0.55, 0.03),
         Stage::Global => (0.58, 0.02),
         Stage::Smooth => (0.60, 0.20),
-        // The opt-in global Newton steps after the sweeps.
-        Stage::Newton => (0.78, 0.02),
         Stage::Remesh => (0.60, 0.10),
         Stage::Images => (0.70, 0.10),
         Stage::Metrics => (0.80, 0.15),

@@ -4,14 +4,13 @@
 use crate::child::{CHILD_ARG, ChildInput, ChildOutput};
 use crate::config::{Runner, WorkerConfig};
 use crate::progress::Shared;
-use geom::pipeline::Job;
+use geom::pipeline::JobSpec;
 use std::process::{ExitStatus, Stdio};
 use tokio::io::AsyncBufReadExt;
 use tokio::task::JoinHandle;
 
 /// A finished pipeline's report and artifacts.
 pub(crate) struct Finished {
-    pub method: String,
     pub timings_ms: Vec<(String, f64)>,
     pub report: serde_json::Value,
     pub artifacts: Vec<(String, String, Vec<u8>)>,
@@ -29,7 +28,7 @@ pub(crate) enum RunError {
     Stopped,
 }
 
-type ThreadResult = geom::Result<(geom::pipeline::JobOutput, Vec<geom::pipeline::Artifact>)>;
+type ThreadResult = geom::Result<(Box<geom::pipeline::JobReport>, Vec<geom::pipeline::Artifact>)>;
 
 pub(crate) enum Running {
     Thread {
@@ -50,7 +49,7 @@ impl Running {
     /// Starts `job` on `meshes` (bytes, read by the runner under the vertex cap).
     pub async fn start(
         config: &WorkerConfig,
-        job: Job,
+        job: JobSpec,
         meshes: Vec<Vec<u8>>,
         shared: &Shared,
     ) -> Result<Running, RunError> {
@@ -68,15 +67,14 @@ impl Running {
                         .iter()
                         .map(|b| geom::io::read(b, &opts).map(|r| r.mesh))
                         .collect::<geom::Result<Vec<_>>>()?;
-                    geom::pipeline::run_job(&job, &meshes, &mut progress)
+                    geom::pipeline::run_job(&job, &meshes, &mut progress).map(|(r, a)| (Box::new(r), a))
                 });
                 Ok(Running::Thread { handle, result: None })
             }
             Runner::Process { exe } => {
                 let dir = tempfile::Builder::new().prefix("surfmap-job-").tempdir().map_err(internal)?;
-                let spec = job.to_json().map_err(RunError::Geom)?;
                 let input = ChildInput {
-                    job: spec,
+                    job,
                     meshes: meshes.len(),
                     max_vertices: config.max_vertices,
                     memory_bytes: config.job_memory_bytes,
@@ -149,10 +147,10 @@ impl Running {
         self.ended().await;
         match self {
             Running::Thread { result, .. } => match result {
-                Some(Ok(Ok((out, arts)))) => Ok(Finished {
-                    method: out.method.to_string(),
-                    timings_ms: out.timings_ms,
-                    report: out.report,
+                Some(Ok(Ok((report, arts)))) => Ok(Finished {
+                    timings_ms: report.timings_ms().to_vec(),
+                    report: serde_json::to_value(&report)
+                        .map_err(|e| RunError::Geom(geom::Error::Internal(e.to_string())))?,
                     artifacts: arts.into_iter().map(|a| (a.name, a.content_type.to_string(), a.bytes)).collect(),
                 }),
                 Some(Ok(Err(geom::Error::Cancelled))) if stopped => Err(RunError::Stopped),
@@ -192,13 +190,13 @@ async fn read_output(dir: &std::path::Path) -> Result<Finished, RunError> {
     let bytes = tokio::fs::read(dir.join("result.json")).await.map_err(|e| internal(e.to_string()))?;
     let out: ChildOutput = serde_json::from_slice(&bytes).map_err(|e| internal(e.to_string()))?;
     match out {
-        ChildOutput::Succeeded { method, timings_ms, report, artifacts } => {
+        ChildOutput::Succeeded { timings_ms, report, artifacts } => {
             let mut arts = Vec::with_capacity(artifacts.len());
             for (k, a) in artifacts.into_iter().enumerate() {
                 let b = tokio::fs::read(dir.join(format!("out_{k}"))).await.map_err(|e| internal(e.to_string()))?;
                 arts.push((a.name, a.content_type, b));
             }
-            Ok(Finished { method, timings_ms, report, artifacts: arts })
+            Ok(Finished { timings_ms, report, artifacts: arts })
         }
         ChildOutput::Failed { code, message, internal } => Err(RunError::Failed { code, message, internal }),
     }

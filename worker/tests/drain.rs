@@ -39,8 +39,7 @@ async fn submit(s: &Setup, spec: String) -> String {
         idempotency_key: None,
         method: "voronoi".into(),
         spec,
-        source: s.source.clone(),
-        target: s.target.clone(),
+        meshes: vec![s.source.clone(), s.target.clone()],
         max_attempts: 3,
     };
     s.worker.store.insert_job(&job).await.unwrap().0.id

@@ -1,7 +1,7 @@
 //! Cross-parameterization over a common base domain (Kraevoy & Sheffer 2004, section 4): every
 //! patch of both refined meshes is mapped onto one shared canonical triangle ([`patch_param`]),
 //! and a vertex of one mesh is carried to the other by locating its triangle coordinates in the
-//! other mesh's embedding of the same patch ([`compose`], [`locate2d`]). [`global`] maps each
+//! other mesh's embedding of the same patch ([`compose`], [`crate::planar::locate`]). [`global`] maps each
 //! closed mesh onto the whole base domain at once, path vertices free, as a second candidate
 //! composition that does not depend on where each mesh's paths were traced. [`smooth`] then lowers
 //! the stretch by relocating vertices inside the common domain; [`visible`] and [`slide`] fix what
@@ -11,8 +11,6 @@
 pub mod compose;
 pub mod foldover_free;
 pub mod global;
-pub mod locate2d;
-pub mod newton;
 pub mod patch_param;
 pub mod planar_untangle;
 pub mod slide;

@@ -5,7 +5,6 @@
 //! same side.
 
 use super::TRIANGLE;
-use super::locate2d::Grid;
 use crate::domain::Patch;
 use crate::domain::refine::Refined;
 use crate::error::{Error, Result};
@@ -14,6 +13,7 @@ use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::param::{
     BoundaryShape, StretchOptions, Uv, check_injective, disk_boundary, map_boundary_to_polygon, minimize_stretch,
 };
+use crate::planar::locate::Grid;
 use crate::progress::Progress;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

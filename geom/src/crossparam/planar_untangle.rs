@@ -6,10 +6,7 @@
 use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::param::Uv;
 
-/// Twice the signed area of a planar triangle (positive counter-clockwise).
-pub(crate) fn signed_area(t: [Uv; 3]) -> f64 {
-    (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[2][0] - t[0][0]) * (t[1][1] - t[0][1])
-}
+pub(crate) use crate::planar::triangle_area2 as signed_area;
 
 /// Sweeps of [`kernel_sweeps`] at most.
 const KERNEL_SWEEPS: usize = 30;

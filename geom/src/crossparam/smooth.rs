@@ -28,18 +28,11 @@ pub struct SmoothOptions {
     pub tolerance: f64,
     /// Fraction of the way to the relaxed position tried first (halved on rejection, twice).
     pub step: f64,
-    /// Weight of the mapped (chord) area, subtracted from each star's energy (times the target
-    /// scaled to the source's area). A vertex moving inside a flat star leaves its area
-    /// unchanged, so the term acts only where the target curves: it favours images that keep
-    /// chords close to the surface (on ridges, spread around thin parts), which the evaluator
-    /// sees as an area ratio nearer 1. Off (0) by default: a map of a mesh onto itself is then
-    /// no longer the identity, since moving a saddle vertex can lengthen chords.
-    pub area_weight: f64,
 }
 
 impl Default for SmoothOptions {
     fn default() -> Self {
-        Self { iterations: 10, step: 1.0, tolerance: 1e-4, area_weight: 0.0 }
+        Self { iterations: 10, step: 1.0, tolerance: 1e-4 }
     }
 }
 
@@ -53,8 +46,6 @@ pub struct SmoothReport {
     /// Regions around remaining folds re-embedded through a target chart (`untangle`).
     pub reembedded: usize,
     pub untangled: usize,
-    /// Global projected-Newton steps taken after the sweeps ([`super::newton`], opt-in).
-    pub newton_steps: usize,
     pub moves: usize,
     pub rejected: usize,
     pub energy_before: f64,
@@ -68,7 +59,6 @@ impl SmoothReport {
             repaired: self.repaired + o.repaired,
             reembedded: self.reembedded + o.reembedded,
             untangled: self.untangled + o.untangled,
-            newton_steps: self.newton_steps + o.newton_steps,
             moves: self.moves + o.moves,
             rejected: self.rejected + o.rejected,
             energy_before: self.energy_before + o.energy_before,
@@ -286,11 +276,6 @@ pub fn smooth(
     // The target's normal at each image, from the face it lies on.
     let tnormal = |f: FaceId| -> V3 { target.face_normal_raw(f) };
     let mut img_face: Vec<FaceId> = map.face.clone();
-    // Chord-area reward per unit of cross-product length: half the weight times the scale squared.
-    let aw = 0.5 * opts.area_weight * scale * scale;
-    // One face's share of a star's objective: its energy minus the area reward.
-    let face_term =
-        |fr: &SourceFrame, m: [P3; 3], nm: V3| -> Option<f64> { Some(fr.energy(m, scale)? - aw * nm.norm()) };
     let frames: Vec<Option<SourceFrame>> =
         (0..source.n_faces()).map(|f| SourceFrame::new(source.face_points(FaceId::from_idx(f)))).collect();
     let star_energy = |v: VertexId, pos: &[P3], img_face: &[FaceId], p: P3, f: FaceId| -> Option<f64> {
@@ -307,7 +292,7 @@ pub fn smooth(
             if nm.dot(&tnormal(f)) <= 0.0 {
                 return None;
             }
-            e += face_term(frames[h.face().idx()].as_ref()?, m, nm)?;
+            e += frames[h.face().idx()].as_ref()?.energy(m, scale)?;
         }
         Some(e)
     };
@@ -320,37 +305,25 @@ pub fn smooth(
             .sum::<f64>()
     };
     // Newton step of the star energy (without the orientation test) over the tangent plane
-    // `p + a t1 + b t2`: exact derivatives (`SourceFrame::energy_derivatives`), or central
-    // differences at a tenth of a percent of the star's size when the area reward is on;
-    // `None` where the Hessian is not positive definite.
+    // `p + a t1 + b t2`, with exact derivatives (`SourceFrame::energy_derivatives`); `None`
+    // where the Hessian is not positive definite.
     let newton_goal = |v: VertexId, pos: &[P3], normal: V3| -> Option<P3> {
         let p = pos[v.idx()];
         let nl = normal.norm();
         if nl <= 0.0 {
             return None;
         }
-        let [t1, t2] = super::newton::tangents(normal);
+        let [t1, t2] = tangents(normal);
         let (mut reach, mut k) = (0.0, 0.0);
         for w in source.vertex_neighbors(v) {
             reach += (pos[w.idx()] - p).norm();
             k += 1.0;
         }
         let reach = reach / f64::max(k, 1.0);
-        let h = 1e-3 * reach;
-        if h <= 0.0 {
+        if reach <= 0.0 {
             return None;
         }
-        let e = |a: f64, b: f64| -> Option<f64> {
-            let q = p + t1 * a + t2 * b;
-            let mut sum = 0.0;
-            for he in source.outgoing(v) {
-                let tri = source.face(he.face());
-                let m = tri.map(|w| if w == v { q } else { pos[w.idx()] });
-                sum += face_term(frames[he.face().idx()].as_ref()?, m, (m[1] - m[0]).cross(&(m[2] - m[0])))?;
-            }
-            Some(sum)
-        };
-        let (g, h11, h22, h12) = if aw == 0.0 {
+        let (g, h11, h22, h12) = {
             // Exact derivatives of the symmetric Dirichlet energy.
             let (mut g, mut hs) = ([0.0; 2], [[0.0; 2]; 2]);
             for he in source.outgoing(v) {
@@ -366,15 +339,6 @@ pub fn smooth(
                 }
             }
             (g, hs[0][0], hs[1][1], hs[0][1])
-        } else {
-            // Central differences (the area reward's derivatives are not written out).
-            let e0 = e(0.0, 0.0)?;
-            let (ea, eb, ec, ed) = (e(h, 0.0)?, e(-h, 0.0)?, e(0.0, h)?, e(0.0, -h)?);
-            let g = [(ea - eb) / (2.0 * h), (ec - ed) / (2.0 * h)];
-            let h11 = (ea - 2.0 * e0 + eb) / (h * h);
-            let h22 = (ec - 2.0 * e0 + ed) / (h * h);
-            let h12 = (e(h, h)? - e(h, -h)? - e(-h, h)? + e(-h, -h)?) / (4.0 * h * h);
-            (g, h11, h22, h12)
         };
         let det = h11 * h22 - h12 * h12;
         if !(h11 > 0.0 && det > 0.0) {
@@ -508,6 +472,13 @@ pub fn smooth(
     }
     rep.energy_after = total(&pos);
     Ok((map, rep))
+}
+
+/// An orthonormal pair spanning the plane normal to `n` (not zero).
+pub(crate) fn tangents(n: V3) -> [V3; 2] {
+    let n = n.normalize();
+    let t1 = if n.x.abs() < 0.9 { V3::x().cross(&n) } else { V3::y().cross(&n) }.normalize();
+    [t1, n.cross(&t1)]
 }
 
 #[cfg(test)]

@@ -19,7 +19,6 @@
 //! fewer than before; otherwise `R` grows by two rings and the step is retried.
 
 use super::foldover_free::{FoldoverFreeOptions, foldover_free};
-use super::locate2d::Grid;
 use super::planar_untangle::{kernel_sweeps, signed_area, spread_ring, untangle_planar};
 use super::visible::{evaluator_folded, fold_suspects, unit_normals};
 use crate::error::Result;
@@ -28,6 +27,7 @@ use crate::map::SurfaceMap;
 use crate::mesh::{FaceId, Mesh, P3, V3, VertexId};
 use crate::metrics::SurfaceIndex;
 use crate::param::{BoundaryShape, DiskParamOptions, Uv, disk_boundary, parameterize_disk};
+use crate::planar::locate::Grid;
 use crate::topology::SurfacePoint;
 use serde::{Deserialize, Serialize};
 

@@ -17,11 +17,11 @@
 //! paper's "refine the mesh locally where curves would share edges"), the base vertex's
 //! valence is raised and, failing that, the mesh is subdivided at edge midpoints.
 
-use super::cut::{CutMesh, cut_along, path_edges};
-use super::refine::Refined;
 use super::search::{each_nonseparating_loop, interior_path};
 use super::word::{Letter, canonical_rotation, canonical_rotations, intersection_matrix, read_word};
 use crate::error::{Error, InputError, Result};
+use crate::mesh::cut::{CutMesh, cut_along, path_edges};
+use crate::mesh::refine::Refined;
 use crate::mesh::{Mesh, VertexId};
 use crate::topology;
 use serde::{Deserialize, Serialize};
@@ -344,11 +344,11 @@ fn rethread(before: &Mesh, after: &Mesh, loops: &[Vec<VertexId>]) -> Option<Loop
         .map(|l| {
             let mut out = vec![*l.first()?];
             for w in l.windows(2) {
-                if super::cut::edge_between(after, w[0], w[1]).is_none() {
+                if crate::mesh::cut::edge_between(after, w[0], w[1]).is_none() {
                     let mid = nalgebra::center(&before.position(w[0]), &before.position(w[1]));
-                    let m = after
-                        .vertex_neighbors(w[0])
-                        .find(|&m| after.position(m) == mid && super::cut::edge_between(after, m, w[1]).is_some())?;
+                    let m = after.vertex_neighbors(w[0]).find(|&m| {
+                        after.position(m) == mid && crate::mesh::cut::edge_between(after, m, w[1]).is_some()
+                    })?;
                     out.push(m);
                 }
                 out.push(w[1]);
@@ -489,7 +489,7 @@ fn middle_copy(s1: &CutMesh, s: &CutMesh, copies: &[VertexId]) -> Option<VertexI
         let (Some(&first), Some(&last)) = (nb.first(), nb.last()) else { return false };
         let old = |w: VertexId| {
             let (Some(sc), Some(sw)) = (s1_local(s1, s, c), s1_local(s1, s, w)) else { return true };
-            super::cut::edge_between(&s.mesh, sc, sw).is_some_and(|e| s.mesh.is_boundary_edge(e))
+            crate::mesh::cut::edge_between(&s.mesh, sc, sw).is_some_and(|e| s.mesh.is_boundary_edge(e))
         };
         !old(first) && !old(last)
     })

@@ -75,7 +75,7 @@ impl IntCohomology {
             if w[0] == w[1] {
                 continue;
             }
-            let e = super::cut::edge_between(mesh, w[0], w[1])?;
+            let e = crate::mesh::cut::edge_between(mesh, w[0], w[1])?;
             let sign = if mesh.edge_vertices(e)[0] == w[0] { 1 } else { -1 };
             for (k, ck) in c.iter_mut().enumerate() {
                 *ck += i64::from(sign * self.value(e, k));
@@ -260,7 +260,7 @@ mod tests {
 
     fn mask_of(m: &Mesh, c: &Cohomology, path: &[u32]) -> u64 {
         path.windows(2)
-            .map(|w| crate::homology::cut::edge_between(m, VertexId(w[0]), VertexId(w[1])).unwrap())
+            .map(|w| crate::mesh::cut::edge_between(m, VertexId(w[0]), VertexId(w[1])).unwrap())
             .fold(0, |acc, e| acc ^ c.mask[e.idx()])
     }
 
@@ -308,7 +308,7 @@ mod tests {
     fn more_than_one_boundary_loop_is_refused() {
         let t = shapes::torus(12, 6, 1.0, 0.3);
         let tube: Vec<VertexId> = (0..=6).map(|j| VertexId((j % 6) as u32)).collect();
-        let cut = crate::homology::cut::cut_along(&t, &crate::homology::cut::path_edges(&t, &[tube]).unwrap()).unwrap();
+        let cut = crate::mesh::cut::cut_along(&t, &crate::mesh::cut::path_edges(&t, &[tube]).unwrap()).unwrap();
         // An annulus: two boundary loops (the capped version is refused: more than one loop).
         assert_eq!(boundary_loops(&cut.mesh).len(), 2);
         assert!(z2_cohomology(&cut.mesh, &[]).is_err());

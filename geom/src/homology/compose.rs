@@ -2,13 +2,13 @@
 //! maps and the feature maps: every vertex of one mesh is located in the other's planar disk,
 //! and the anchor warp that holds interior anchors on their partners.
 
-use super::cut::CutMesh;
-use super::refine::Refined;
-use crate::crossparam::locate2d::Grid;
 use crate::error::Result;
 use crate::map::SurfaceMap;
+use crate::mesh::cut::CutMesh;
+use crate::mesh::refine::Refined;
 use crate::mesh::{FaceId, VertexId};
 use crate::param::Uv;
+use crate::planar::locate::Grid;
 
 /// A cut disk with its planar positions and, when the disk was cut from a refinement, the
 /// refinement (to convert points back to the original mesh).

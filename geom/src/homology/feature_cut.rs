@@ -15,10 +15,10 @@
 //! a single way around, so the boundary word depends on the curves' order alone — two meshes
 //! always produce the same word, with no cyclic order to reconcile at a branch point.
 
-use super::cut::{CutMesh, cut_along, path_edges};
 use super::features::{Curve, CurveKind, doubled_genus};
 use super::search;
 use crate::error::{Error, InputError, Result};
+use crate::mesh::cut::{CutMesh, cut_along, path_edges};
 use crate::mesh::{Mesh, VertexId};
 use crate::topology;
 use std::collections::HashMap;

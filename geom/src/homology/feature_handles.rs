@@ -15,10 +15,10 @@
 //! composition, boundary snapping), through the basis's refinement.
 
 use super::basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis_avoiding};
-use super::cut::CutMesh;
 use super::feature_cut::{FeatureCutResult, Side, SideKind, chain_order_to_base, feature_cut};
 use super::features::{Curve, CurveKind, doubled_genus};
 use crate::error::{Error, InputError, Result};
+use crate::mesh::cut::CutMesh;
 use crate::mesh::{Mesh, VertexId};
 
 /// One mesh's basis (with the curves on its refinement) and the disk cut along it.

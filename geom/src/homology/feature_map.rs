@@ -10,9 +10,9 @@ use super::feature_cut::{FeatureCutResult, chain_order, feature_cut};
 use super::feature_domain::{FeatureDomainResult, feature_domain, shared_arcs};
 use super::feature_handles::{HandleCutOptions, HandleCuts, handle_cuts};
 use super::features::{Curve, CurveKind};
-use super::refine::Refined;
 use crate::error::{InputError, Result};
 use crate::map::SurfaceMap;
+use crate::mesh::refine::Refined;
 use crate::mesh::{Mesh, P3, VertexId};
 
 /// One mesh's cut and domain.

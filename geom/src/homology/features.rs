@@ -9,8 +9,8 @@
 //! states). The cut that [`super::feature_cut`] makes is the half of a cut of the double cover
 //! that is symmetric under the deck involution, see there.
 
-use super::cut::{cut_along, edge_between, path_edges};
 use crate::error::{Error, InputError, Result};
+use crate::mesh::cut::{cut_along, edge_between, path_edges};
 use crate::mesh::{Mesh, VertexId};
 use crate::topology;
 
@@ -143,7 +143,7 @@ pub fn double_cover(mesh: &Mesh, curves: &[Curve]) -> Result<Mesh> {
         .map(|e| slit.mesh.edge_vertices(e))
         .filter(|[a, b]| slit.mesh.is_boundary_vertex(*a) && slit.mesh.is_boundary_vertex(*b))
         .collect();
-    let refined = super::refine::Refined::identity(&slit.mesh).split_edges(&chords)?;
+    let refined = crate::mesh::refine::Refined::identity(&slit.mesh).split_edges(&chords)?;
     let m = &refined.mesh;
     let n = m.n_vertices();
     let mut pos = m.positions().to_vec();

@@ -1,8 +1,10 @@
 //! Method `homology` (Carner, Jin, Gu, Qin 2005): canonical homology bases through one base
 //! vertex, the 4g-gon fundamental domain they cut, and maps between two surfaces through it.
 //!
-//! - [`refine`]: midpoint refinement that remembers where every refined face lies.
-//! - [`cut`]: slicing a mesh open along edge paths.
+//! Shared tools it builds on live below it: [`crate::mesh::refine`] (midpoint refinement that
+//! remembers where every refined face lies), [`crate::mesh::cut`] (slicing a mesh open along edge
+//! paths) and [`crate::planar`] (point location in a plane).
+//!
 //! - [`cocycle`]: Z2 cohomology by tree–cotree (which loops are non-separating).
 //! - [`search`]: shortest non-separating loops and side-to-side paths on a cut surface.
 //! - [`word`]: boundary words, the canonical rotation, intersection numbers at the base.
@@ -25,7 +27,6 @@ pub mod classes;
 pub mod cocycle;
 pub mod compose;
 pub mod curve_align;
-pub mod cut;
 pub mod domain;
 pub mod feature_cut;
 pub mod feature_domain;
@@ -37,7 +38,6 @@ pub mod map;
 pub mod matching;
 pub mod overlay;
 pub mod prune;
-pub mod refine;
 pub mod search;
 pub mod word;
 

@@ -9,10 +9,10 @@
 //! on the source (barycentric in the source triangle it lies in) and on the target.
 
 use super::map::SideDomain;
-use crate::crossparam::locate2d::barycentric;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, P3, VertexId};
 use crate::param::Uv;
+use crate::planar::locate::barycentric;
 use std::collections::HashMap;
 
 /// The merged tessellation.
@@ -103,9 +103,7 @@ fn bbox(t: [Uv; 3]) -> [f64; 4] {
     ]
 }
 
-fn cross(a: Uv, b: Uv, c: Uv) -> f64 {
-    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-}
+use crate::planar::area2 as cross;
 
 /// Overlays the source's domain (turned by `angle`) and the target's.
 ///

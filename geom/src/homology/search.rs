@@ -4,8 +4,8 @@
 //! loops they produce meet only at the base vertex.
 
 use super::cocycle::z2_cohomology;
-use super::cut::{CutMesh, cut_along, edge_between, path_edges};
 use crate::error::Result;
+use crate::mesh::cut::{CutMesh, cut_along, edge_between, path_edges};
 use crate::mesh::{EdgeId, Mesh, VertexId};
 use crate::topology::boundary_loops;
 use std::cmp::Ordering;

@@ -7,8 +7,10 @@
 //! [`Mesh::from_raw`] refuses or repairs (with a warning) anything else.
 
 mod build;
+pub mod cut;
 mod cut_copy;
 mod ids;
+pub mod refine;
 pub mod shapes;
 mod triangulate;
 

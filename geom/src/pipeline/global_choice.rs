@@ -2,7 +2,7 @@
 //! per-patch composition: compared before smoothing, and when neither wins on every count,
 //! compared again after both are relaxed.
 
-use super::run::both;
+use super::common::both;
 use crate::crossparam::smooth;
 use crate::domain::refine::Refined;
 use crate::error::{Error, Result};

@@ -4,7 +4,7 @@
 //! to measured peaks (the resident set of `surfmap map` / `surfmap remesh`; `bench/NOTES.md`)
 //! and rounded up, so the estimate errs high.
 
-use super::job::Job;
+use super::spec::JobSpec;
 use crate::topology::Summary;
 
 /// Fixed cost of any job's process: its mapped executable, thread stacks and two allocator
@@ -22,23 +22,26 @@ const PER_REMESH_SAMPLE: u64 = 256;
 /// Bytes per written vertex of an OBJ output (text held in memory before it is stored).
 const PER_OUTPUT_VERTEX: u64 = 96;
 
-impl Job {
+impl JobSpec {
     /// Estimated peak memory in bytes on meshes with these summaries (an upper estimate).
     pub fn memory_estimate(&self, summaries: &[Summary]) -> u64 {
         let vertices: u64 = summaries.iter().map(|s| s.vertices as u64).sum();
         let edges: u64 = summaries.iter().map(|s| s.edges as u64).sum();
+        let pair = |layout: &crate::domain::LayoutOptions, samples: usize| {
+            let n = &layout.edge_nodes;
+            let per_edge = u64::from(n.min_nodes.max(1)) * u64::from(n.ring_factor.max(1));
+            let nodes = edges.saturating_mul(per_edge.min(u64::from(n.max_nodes.max(1))));
+            PER_VERTEX
+                .saturating_mul(vertices)
+                .saturating_add(PER_EDGE_NODE.saturating_mul(nodes))
+                .saturating_add(PER_SAMPLE.saturating_mul(2 * samples as u64))
+        };
         let bytes = match self {
-            Job::Map(spec) => {
-                let o = &spec.options;
-                let n = &o.layout.edge_nodes;
-                let per_edge = u64::from(n.min_nodes.max(1)) * u64::from(n.ring_factor.max(1));
-                let nodes = edges.saturating_mul(per_edge.min(u64::from(n.max_nodes.max(1))));
-                PER_VERTEX
-                    .saturating_mul(vertices)
-                    .saturating_add(PER_EDGE_NODE.saturating_mul(nodes))
-                    .saturating_add(PER_SAMPLE.saturating_mul(2 * o.metric_samples as u64))
-            }
-            Job::Remesh(spec) => {
+            JobSpec::Voronoi(spec) | JobSpec::Greedy(spec) => pair(&spec.options.layout, spec.options.metric_samples),
+            // Cut meshes, subdivided bases and the maps: measured below a layout job's peak at
+            // the default layout options.
+            JobSpec::Homology(spec) => pair(&Default::default(), spec.options.metric_samples),
+            JobSpec::Quad(spec) => {
                 let o = &spec.options;
                 let models = summaries.len() as u64;
                 let genus = summaries.first().map_or(0, |s| s.genus.max(0) as u64);

@@ -1,24 +1,188 @@
-//! The one call the CLI and the worker share: a validated [`JobSpec`] and two meshes in,
-//! named artifacts and metrics out. Nothing here touches files or sockets; callers write the
-//! artifacts wherever they keep them.
+//! One job, one call: a typed [`JobSpec`] and its meshes in, a report and named artifacts out.
+//! Nothing here touches files or sockets; callers write the artifacts wherever they keep them.
+//!
+//! [`run_job`] dispatches once, on the spec's method, to one pipeline per method
+//! ([`voronoi`] for `voronoi` and `greedy`, [`homology`], [`features`] for `homology` with
+//! feature curves or boundaries, [`quad`]). Each imports [`common`] and the spec, never another
+//! method's file.
 
-mod artifacts;
+mod check;
+pub mod common;
+pub mod features;
 mod global_choice;
-mod job;
+pub mod homology;
+mod limits;
 mod memory;
+pub mod quad;
+mod quad_spec;
 mod ranges;
-mod remesh_spec;
-mod run;
-mod run_features;
-mod run_homology;
-mod run_quad;
 mod spec;
+pub mod voronoi;
 
-pub use job::{Job, JobOutput, METHODS, run_job};
-pub use ranges::{MAX_EDGE_NODES, MAX_METRIC_SAMPLES, MAX_MORPH_FRAMES};
-pub use remesh_spec::{
-    Interpolation, LevelSchedule, MAX_MODELS, MorphDomain, MorphOptions, QuadMethod, QuadOptions, RemeshSpec,
+pub use common::{Artifact, PairReport};
+pub use limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_FEATURES, MAX_METRIC_SAMPLES, MAX_MODELS, MAX_MORPH_FRAMES};
+pub use quad::{QuadReport, Remeshes, remesh_all_for_bench};
+pub use quad_spec::{Interpolation, LevelSchedule, MorphDomain, MorphOptions, QuadOptions, QuadSpec};
+pub use spec::{
+    FeatureSpec, GlobalOptions, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, METHODS, MapOptions, Method,
+    RelaxOptions,
 };
-pub use run::{Artifact, MapReport, run_map};
-pub use run_quad::{RemeshReport, Remeshes, remesh_all_for_bench, run_remesh};
-pub use spec::{FeatureSpec, JobSpec, MAX_ANCHORS, MAX_FEATURES, MapOptions, Method};
+
+use crate::error::{InputError, Result};
+use crate::mesh::Mesh;
+use crate::progress::Progress;
+use serde::Serialize;
+
+/// A finished job's report (`metrics.json`), one type per pipeline.
+#[derive(Debug, Clone, Serialize)]
+#[serde(untagged)]
+pub enum JobReport {
+    Layout(voronoi::LayoutMapReport),
+    Homology(homology::HomologyMapReport),
+    Features(features::FeatureMapReport),
+    Quad(QuadReport),
+}
+
+impl JobReport {
+    /// Both directions' metrics of a pair job.
+    pub fn pair(&self) -> Option<&PairReport> {
+        match self {
+            JobReport::Layout(r) => Some(&r.pair),
+            JobReport::Homology(r) => Some(&r.pair),
+            JobReport::Features(r) => Some(&r.pair),
+            JobReport::Quad(_) => None,
+        }
+    }
+
+    /// Milliseconds per stage.
+    pub fn timings_ms(&self) -> &[(String, f64)] {
+        match self {
+            JobReport::Quad(r) => &r.timings_ms,
+            _ => self.pair().map_or(&[], |p| &p.timings_ms),
+        }
+    }
+}
+
+/// Runs any job on its meshes (two for pair jobs, in source, target order).
+///
+/// # Errors
+/// `InputError::Spec` for the wrong number of meshes; whatever the method reports.
+pub fn run_job(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Result<(JobReport, Vec<Artifact>)> {
+    let pair = || match meshes {
+        [s, t] => Ok((s, t)),
+        _ => Err(InputError::Spec(format!(
+            "method {} maps a source onto a target: 2 meshes, got {}",
+            spec.method().name(),
+            meshes.len()
+        ))),
+    };
+    Ok(match spec {
+        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => {
+            let (a, b) = pair()?;
+            let (r, arts) = voronoi::run(spec.method(), s, a, b, progress)?;
+            (JobReport::Layout(r), arts)
+        }
+        JobSpec::Homology(s) => {
+            let (a, b) = pair()?;
+            if features::applies(s, a) {
+                let (r, arts) = features::run(s, a, b, progress)?;
+                (JobReport::Features(r), arts)
+            } else {
+                let (r, arts) = homology::run(s, a, b, progress)?;
+                (JobReport::Homology(r), arts)
+            }
+        }
+        JobSpec::Quad(s) => {
+            let (r, arts) = quad::run(s, meshes, progress)?;
+            (JobReport::Quad(r), arts)
+        }
+    })
+}
+#[cfg(test)]
+mod cancel_tests {
+    use super::*;
+    use crate::error::Error;
+    use crate::mesh::shapes;
+    use crate::progress::{CancelToken, Stage};
+
+    /// Cancels its token when a stage starts and records every stage reported.
+    struct CancelAt {
+        stage: Stage,
+        token: CancelToken,
+        seen: Vec<Stage>,
+    }
+
+    impl Progress for CancelAt {
+        fn report(&mut self, stage: Stage, _fraction: f64) {
+            if stage == self.stage {
+                self.token.cancel();
+            }
+            self.seen.push(stage);
+        }
+        fn cancelled(&self) -> bool {
+            self.token.is_cancelled()
+        }
+        fn token(&self) -> Option<CancelToken> {
+            Some(self.token.clone())
+        }
+    }
+
+    /// A cancel inside the smoothing stage ends the job with `Cancelled` before any later stage
+    /// (both halves of the parallel split see it: the side half through `Progress::silent`).
+    #[test]
+    fn a_cancel_inside_a_stage_stops_the_job_there() {
+        let s = shapes::icosphere(3);
+        let t =
+            s.with_positions(s.positions().iter().map(|p| crate::mesh::P3::new(p.x * 1.4, p.y, p.z * 0.8)).collect());
+        let t = t.unwrap();
+        let anchors: Vec<[u64; 2]> = [0u64, 5, 9, 13, 21, 40].iter().map(|&i| [i, i]).collect();
+        let spec = JobSpec::Voronoi(LayoutSpec { anchors, options: MapOptions::default() });
+        let mut p = CancelAt { stage: Stage::Smooth, token: CancelToken::default(), seen: Vec::new() };
+        let r = run_job(&spec, &[s, t], &mut p);
+        assert!(matches!(r, Err(Error::Cancelled)), "{:?}", r.err());
+        assert!(p.seen.contains(&Stage::Smooth), "{:?}", p.seen);
+        assert!(
+            !p.seen.iter().any(|s| matches!(s, Stage::Metrics | Stage::Done)),
+            "ran on after the cancel: {:?}",
+            p.seen
+        );
+    }
+}
+
+#[cfg(test)]
+mod spec_tests {
+    use super::*;
+
+    /// Every method's spec reads back from its own JSON as the same value: what the server
+    /// stores is what the worker runs.
+    #[test]
+    fn every_spec_round_trips_through_its_json() {
+        let specs = [
+            r#"{"method": "voronoi", "anchors": [[0, 1], [2, 3], [4, 5]], "options": {"layout": {"rebuilds": 2}, "global": {"enabled": false}}}"#,
+            r#"{"method": "greedy", "anchors": [[0, 1], [2, 3], [4, 5]]}"#,
+            r#"{"method": "homology", "anchors": [[0, 0]], "features": [{"source": [1, 2], "target": [3, 4]}], "options": {"basis": [1, 0], "matching": ["a1 -> b1", "b1 -> -a1"], "dihedral_threshold_deg": 12.5}}"#,
+            r#"{"method": "quad", "anchors": [[0, 0, 0], [1, 1, 1], [2, 2, 2], [3, 3, 3]], "options": {"level": 4, "morph": {"interpolation": "spline", "schedule": [{"start": 0.1, "speed": 2.0}]}}}"#,
+        ];
+        for text in specs {
+            let spec = JobSpec::from_json(text.as_bytes()).unwrap();
+            let again = JobSpec::from_json(spec.to_json().unwrap().as_bytes()).unwrap();
+            assert_eq!(spec, again, "{text}");
+        }
+    }
+
+    #[test]
+    fn unknown_methods_and_fields_are_named() {
+        let e = JobSpec::from_json(br#"{"method": "nope", "anchors": []}"#).unwrap_err();
+        assert_eq!(e.code(), "unknown_method");
+        assert!(e.to_string().contains("voronoi, greedy, homology, quad"), "{e}");
+        // Options of one method are unknown fields of another.
+        let e =
+            JobSpec::from_json(br#"{"method": "voronoi", "anchors": [], "options": {"basis": [0, 0]}}"#).unwrap_err();
+        assert_eq!(e.code(), "invalid_spec");
+        assert!(e.to_string().contains("basis"), "{e}");
+        let e = JobSpec::from_json(br#"{"method": "greedy", "anchors": [], "features": []}"#).unwrap_err();
+        assert!(e.to_string().contains("features"), "{e}");
+        let e = JobSpec::from_json(br#"{"anchors": []}"#).unwrap_err();
+        assert_eq!(e.code(), "invalid_spec");
+    }
+}

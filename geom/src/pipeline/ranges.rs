@@ -7,16 +7,12 @@
 //! case has needed, and small enough that the job's memory stays proportional to its meshes
 //! (see [`super::memory`]).
 
-use super::remesh_spec::QuadOptions;
-use super::spec::MapOptions;
+use super::quad_spec::QuadOptions;
+use super::spec::{HomologyOptions, MapOptions};
+use crate::crossparam::smooth::SmoothOptions;
 use crate::error::{InputError, Result};
 
-/// Most surface samples per direction for the distortion metrics (10× the evaluator's).
-pub const MAX_METRIC_SAMPLES: usize = 1_000_000;
-/// Most edge nodes per mesh edge in the layout construction.
-pub const MAX_EDGE_NODES: u32 = 256;
-/// Most OBJ frames a `quad` morph writes.
-pub const MAX_MORPH_FRAMES: usize = 1_000;
+use super::limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_METRIC_SAMPLES, MAX_MORPH_FRAMES};
 
 fn out_of_range(field: &str, value: impl std::fmt::Display, range: &str) -> crate::error::Error {
     InputError::OptionRange(format!("options.{field} = {value} is outside its range {range}")).into()
@@ -43,7 +39,7 @@ fn size(field: &str, v: usize, lo: u64, hi: u64) -> Result<()> {
 }
 
 impl MapOptions {
-    /// Checks every option of a `voronoi`, `greedy` or `homology` job against its range.
+    /// Checks every option of a `voronoi` or `greedy` job against its range.
     ///
     /// # Errors
     /// `InputError::OptionRange` naming the first field out of range and the range.
@@ -63,35 +59,21 @@ impl MapOptions {
         size("layout.flip.rounds", l.flip.rounds, 0, 100)?;
         real("layout.flip.threshold", l.flip.threshold, 0.0, 2.0, false)?;
         real("layout.flip.max_end_angle", l.flip.max_end_angle, 0.0, 1.0, true)?;
-        if let Some(g) = l.flip.valence_two_max_growth {
-            real("layout.flip.valence_two_max_growth", g, 1.0, 100.0, false)?;
-        }
         size("param.stretch_iterations", self.param.stretch_iterations, 0, 100)?;
-        let g = &self.global;
-        size("global.max_solves", g.max_solves, 1, 100)?;
-        real("global.min_folded_fraction", g.min_folded_fraction, 0.0, 1.0, false)?;
-        real("global.min_area_deviation", g.min_area_deviation, 0.0, 10.0, false)?;
-        let s = &self.smoothing;
-        size("smoothing.iterations", s.iterations, 0, 10_000)?;
-        real("smoothing.tolerance", s.tolerance, 0.0, 1.0, false)?;
-        real("smoothing.step", s.step, 0.0, 1.0, true)?;
-        real("smoothing.area_weight", s.area_weight, 0.0, 100.0, false)?;
-        let n = &self.newton;
-        size("newton.iterations", n.iterations, 0, 10_000)?;
-        real("newton.tolerance", n.tolerance, 0.0, 1.0, false)?;
-        real("newton.max_move", n.max_move, 0.0, 100.0, true)?;
-        real("newton.max_density", n.max_density, 0.0, 1e12, true)?;
-        real("newton.min_cos", n.min_cos, -1.0, 1.0, false)?;
-        let u = &self.untangle;
-        size("untangle.max_rings", u.max_rings, 0, 64)?;
-        size("untangle.chart_rings", u.chart_rings, 0, 64)?;
-        size("untangle.passes", u.passes, 0, 100)?;
-        size("untangle.max_attempts", u.max_attempts, 0, 100_000)?;
-        size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)?;
+        smoothing(&self.smoothing)?;
+        size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)
+    }
+}
+
+impl HomologyOptions {
+    /// Checks every option of a `homology` job against its range.
+    ///
+    /// # Errors
+    /// `InputError::OptionRange` naming the first field out of range and the range.
+    pub fn check_ranges(&self) -> Result<()> {
         size("basis[0]", self.basis[0], 0, 64)?;
         size("basis[1]", self.basis[1], 0, 64)?;
         size("rotation", self.rotation, 0, 1_000)?;
-        size("domain_stretch_iterations", self.domain_stretch_iterations, 0, 100)?;
         if let Some(d) = self.dihedral_threshold_deg {
             real("dihedral_threshold_deg", d, 0.0, 180.0, true)?;
         }
@@ -101,8 +83,15 @@ impl MapOptions {
                 return Err(out_of_range("matching (entry length)", e.len(), "[0, 256]"));
             }
         }
-        Ok(())
+        smoothing(&self.smoothing)?;
+        size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)
     }
+}
+
+fn smoothing(s: &SmoothOptions) -> Result<()> {
+    size("smoothing.iterations", s.iterations, 0, 10_000)?;
+    real("smoothing.tolerance", s.tolerance, 0.0, 1.0, false)?;
+    real("smoothing.step", s.step, 0.0, 1.0, true)
 }
 
 impl QuadOptions {
@@ -120,7 +109,7 @@ impl QuadOptions {
         }
         size("base_vertices", self.base_vertices, 0, 100_000)?;
         size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)?;
-        size("feature_anchors (rows)", self.feature_anchors.len(), 0, super::MAX_ANCHORS as u64)?;
+        size("feature_anchors (rows)", self.feature_anchors.len(), 0, MAX_ANCHORS as u64)?;
         let m = &self.morph;
         size("morph.frames", m.frames, 0, MAX_MORPH_FRAMES as u64)?;
         size("morph.schedule (levels)", m.schedule.len(), 0, 16)?;
@@ -152,6 +141,7 @@ mod tests {
     #[test]
     fn defaults_are_in_range() {
         MapOptions::default().check_ranges().unwrap();
+        HomologyOptions::default().check_ranges().unwrap();
         QuadOptions::default().check_ranges(2).unwrap();
     }
 

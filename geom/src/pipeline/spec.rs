@@ -1,98 +1,70 @@
-//! The job spec: the one description of a mapping job that the CLI (`surfmap map --spec`) and
-//! the server accept, validated here against the two meshes before any work starts.
+//! The job spec: one typed description of any job, parsed once where a request enters (the
+//! server, the CLI) and carried as this type to the store, the worker and the pipeline.
+//!
+//! `{"method": "voronoi" | "greedy", "anchors": [[s, t], ...], "options": {...}}`,
+//! `{"method": "homology", "anchors": [...], "features": [...], "options": {...}}`,
+//! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}`.
+//! Each method has its own options type; unknown fields are refused at every depth.
 
+use super::quad_spec::QuadSpec;
 use crate::crossparam::PatchParamOptions;
 use crate::crossparam::smooth::SmoothOptions;
 use crate::domain::LayoutOptions;
-use crate::error::{InputError, Result};
-use crate::homology::features::{Curve, check_disjoint, validate_curve};
-use crate::mesh::{Mesh, VertexId};
-use crate::topology;
+use crate::error::{Error, InputError, Result};
 use serde::{Deserialize, Serialize};
 
-/// The mapping method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Method {
+/// Every method a job may name, in [`Method`] order.
+pub const METHODS: [&str; 4] = ["voronoi", "greedy", "homology", "quad"];
+
+/// A job: its method, with that method's anchors and options.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "snake_case")]
+pub enum JobSpec {
     /// Common base domains from Voronoi cues (Kwok, Zhang, Wang).
-    Voronoi,
+    Voronoi(LayoutSpec),
     /// The shortest-paths-first heuristic of Kraevoy & Sheffer 2004.
+    Greedy(LayoutSpec),
+    /// Canonical homology bases and the 4g-gon domain (Carner, Jin, Gu, Qin 2005), with
+    /// feature curves and boundaries (their section 3.4).
+    Homology(HomologySpec),
+    /// Consistent quad remeshing of N models (Yu & Chuang).
+    Quad(QuadSpec),
+}
+
+/// The method of a job.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    Voronoi,
     Greedy,
-    /// Canonical homology bases and the 4g-gon domain (Carner, Jin, Gu, Qin 2005).
     Homology,
+    Quad,
 }
 
 impl Method {
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Voronoi => "voronoi",
-            Method::Greedy => "greedy",
-            Method::Homology => "homology",
-        }
+        METHODS[self as usize]
     }
 }
 
-/// Options of a `voronoi` or `greedy` job. Every field has a default.
+/// A `voronoi` or `greedy` job.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct MapOptions {
-    /// Edge nodes and search budget of the layout construction.
-    pub layout: LayoutOptions,
-    /// Weights of the patch parameterization (mean value by default).
-    pub param: PatchParamOptions,
-    /// The global map onto the base domain that frees vertices from the layout paths (closed
-    /// meshes; on by default). The per-patch maps seed it and stand in when it fails.
-    pub global: crate::crossparam::global::GlobalParamOptions,
-    /// Stretch-reducing relocation of vertices across patch boundaries.
-    pub smoothing: SmoothOptions,
-    /// Global projected-Newton relaxation after the smoothing sweeps (moves whole regions).
-    pub newton: crate::crossparam::newton::NewtonOptions,
-    /// Re-embedding of regions around folds that the one-vertex repairs leave.
-    pub untangle: crate::crossparam::untangle::UntangleOptions,
-    /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
-    pub metric_samples: usize,
-    /// `homology`: basis index (0 = shortest) on the source and on the target.
-    pub basis: [usize; 2],
-    /// `homology`: τ rotates the source's 4g-gon by `rotation · 2π/g` (quarter turns for g = 1).
-    pub rotation: usize,
-    /// `homology`: also merge both tessellations into the meta-mesh pair.
-    pub meta_mesh: bool,
-    /// `homology`: Yoshizawa–Belyaev–Seidel stretch-minimizing reweighting rounds of each
-    /// planar domain (0 = the plain mean-value map). Spreads protrusions that the harmonic map
-    /// crushes (a hand cut at the wrist) at the price of more folds between different shapes.
-    pub domain_stretch_iterations: usize,
-    /// `homology` with feature curves or boundaries: align the target's curves to the source's
-    /// vertex by vertex (dynamic time warping of arc length and boundary angle) instead of
-    /// placing both by arc length alone.
-    pub align_curves: bool,
-    /// `homology` with `meta_mesh`: prune the meta-mesh, keeping only edges whose dihedral
-    /// angle exceeds this many degrees on either surface (flat vertices are collapsed).
-    pub dihedral_threshold_deg: Option<f64>,
-    /// `homology`: where each source loop goes, e.g. `["a1 -> b1", "b1 -> -a1"]` or
-    /// `["a1 -> a1+b1", "b1 -> b1"]`; overrides `basis` and `rotation` with a class that induces
-    /// it on H1 (searched over the first few bases and every rotation).
-    pub matching: Option<Vec<String>>,
+#[serde(deny_unknown_fields)]
+pub struct LayoutSpec {
+    pub anchors: Vec<[u64; 2]>,
+    #[serde(default)]
+    pub options: MapOptions,
 }
 
-impl Default for MapOptions {
-    fn default() -> Self {
-        Self {
-            layout: LayoutOptions::default(),
-            param: PatchParamOptions::default(),
-            global: Default::default(),
-            smoothing: SmoothOptions::default(),
-            newton: Default::default(),
-            untangle: Default::default(),
-            metric_samples: 100_000,
-            basis: [0, 0],
-            rotation: 0,
-            meta_mesh: false,
-            domain_stretch_iterations: 0,
-            align_curves: true,
-            dihedral_threshold_deg: None,
-            matching: None,
-        }
-    }
+/// A `homology` job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HomologySpec {
+    pub anchors: Vec<[u64; 2]>,
+    /// Corresponding feature curves, mapped exactly.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub features: Vec<FeatureSpec>,
+    #[serde(default)]
+    pub options: HomologyOptions,
 }
 
 /// One pair of corresponding feature curves: vertex paths on the source and on the target. A
@@ -104,34 +76,141 @@ pub struct FeatureSpec {
     pub target: Vec<u64>,
 }
 
-/// `{"method": ..., "anchors": [[s, t], ...], "features": [...], "options": {...}}`.
+/// Options of a `voronoi` or `greedy` job. Every field has a default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct JobSpec {
-    pub method: Method,
-    pub anchors: Vec<[u64; 2]>,
-    /// `homology`: corresponding feature curves, mapped exactly.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub features: Vec<FeatureSpec>,
-    #[serde(default)]
-    pub options: MapOptions,
+#[serde(default, deny_unknown_fields)]
+pub struct MapOptions {
+    /// Edge nodes and search budget of the layout construction.
+    pub layout: LayoutOptions,
+    /// Weights of the patch parameterization (mean value by default).
+    pub param: PatchParamOptions,
+    /// The global map onto the base domain (closed meshes; on by default).
+    pub global: GlobalOptions,
+    /// Stretch-reducing relocation of vertices across patch boundaries.
+    pub smoothing: SmoothOptions,
+    /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
+    pub metric_samples: usize,
 }
 
-/// Most anchors a job may have.
-pub const MAX_ANCHORS: usize = 4096;
-/// Most feature curves a job may have.
-pub const MAX_FEATURES: usize = 256;
+impl Default for MapOptions {
+    fn default() -> Self {
+        Self {
+            layout: LayoutOptions::default(),
+            param: PatchParamOptions::default(),
+            global: GlobalOptions::default(),
+            smoothing: SmoothOptions::default(),
+            metric_samples: 100_000,
+        }
+    }
+}
+
+/// Whether a `voronoi` / `greedy` job tries the global map onto the base domain, which frees
+/// vertices from the layout paths; the per-patch maps seed it and stand in when it is worse.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GlobalOptions {
+    pub enabled: bool,
+}
+
+impl Default for GlobalOptions {
+    fn default() -> Self {
+        Self { enabled: true }
+    }
+}
+
+/// Options of a `homology` job. Every field has a default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct HomologyOptions {
+    /// Basis index (0 = shortest) on the source and on the target.
+    pub basis: [usize; 2],
+    /// τ rotates the source's 4g-gon by `rotation · 2π/g` (quarter turns for g = 1).
+    pub rotation: usize,
+    /// Where each source loop goes, e.g. `["a1 -> b1", "b1 -> -a1"]`; overrides `basis` and
+    /// `rotation` with a class that induces it on H1.
+    pub matching: Option<Vec<String>>,
+    /// Also merge both tessellations into the meta-mesh pair.
+    pub meta_mesh: bool,
+    /// With `meta_mesh`: keep only edges whose dihedral angle exceeds this many degrees on
+    /// either surface (flat vertices are collapsed).
+    pub dihedral_threshold_deg: Option<f64>,
+    /// With feature curves or boundaries: align the target's curves to the source's vertex by
+    /// vertex (dynamic time warping of arc length and boundary angle) instead of placing both
+    /// by arc length alone.
+    pub align_curves: bool,
+    /// Stretch-reducing relocation of vertices after the domain maps.
+    pub smoothing: SmoothOptions,
+    /// Surface samples per direction for the Hausdorff / RMS metrics.
+    pub metric_samples: usize,
+}
+
+impl Default for HomologyOptions {
+    fn default() -> Self {
+        Self {
+            basis: [0, 0],
+            rotation: 0,
+            matching: None,
+            meta_mesh: false,
+            dihedral_threshold_deg: None,
+            align_curves: true,
+            smoothing: SmoothOptions::default(),
+            metric_samples: 100_000,
+        }
+    }
+}
+
+/// What every pair method's last stages (relaxation and metrics) take from its options.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RelaxOptions {
+    pub smoothing: SmoothOptions,
+    pub metric_samples: usize,
+}
+
+impl MapOptions {
+    pub fn relax(&self) -> RelaxOptions {
+        RelaxOptions { smoothing: self.smoothing, metric_samples: self.metric_samples }
+    }
+}
+
+impl HomologyOptions {
+    pub fn relax(&self) -> RelaxOptions {
+        RelaxOptions { smoothing: self.smoothing, metric_samples: self.metric_samples }
+    }
+}
 
 impl JobSpec {
-    /// Parses a spec from JSON.
+    /// Parses a spec: the one place JSON becomes a job.
     ///
     /// # Errors
-    /// `InputError::Spec` naming the field at fault.
+    /// `InputError::UnknownMethod` for a missing or unknown `"method"`; `InputError::Spec`
+    /// naming the field at fault otherwise.
     pub fn from_json(bytes: &[u8]) -> Result<JobSpec> {
-        serde_json::from_slice(bytes).map_err(|e| InputError::Spec(e.to_string()).into())
+        let v: serde_json::Value =
+            serde_json::from_slice(bytes).map_err(|e| InputError::Spec(format!("spec is not JSON: {e}")))?;
+        JobSpec::from_value(v)
     }
 
-    /// A spec from a bare anchors file `{"anchors": [[s, t], ...]}` or `[[s, t], ...]`.
+    /// [`JobSpec::from_json`] of a spec that arrived inside a larger JSON document.
+    ///
+    /// # Errors
+    /// As [`JobSpec::from_json`].
+    pub fn from_value(v: serde_json::Value) -> Result<JobSpec> {
+        match v.get("method") {
+            Some(serde_json::Value::String(m)) if !METHODS.contains(&m.as_str()) => {
+                return Err(InputError::UnknownMethod(format!(
+                    "unknown method {m:?}; available: {}",
+                    METHODS.join(", ")
+                ))
+                .into());
+            }
+            None => return Err(InputError::Spec("spec has no \"method\"".into()).into()),
+            _ => {}
+        }
+        JobSpec::deserialize(v).map_err(|e| InputError::Spec(e.to_string()).into())
+    }
+
+    /// A `voronoi` or `greedy` spec from a bare anchors file `{"anchors": [[s, t], ...]}` or
+    /// `[[s, t], ...]`, every option at its default.
     ///
     /// # Errors
     /// `InputError::Spec` when the JSON has neither form.
@@ -143,196 +222,33 @@ impl JobSpec {
             List(Vec<[u64; 2]>),
         }
         let a: A = serde_json::from_slice(bytes).map_err(|e| InputError::Spec(format!("anchors file: {e}")))?;
-        let anchors = match a {
-            A::Obj { anchors } | A::List(anchors) => anchors,
-        };
-        Ok(JobSpec { method, anchors, features: Vec::new(), options: MapOptions::default() })
+        let (A::Obj { anchors } | A::List(anchors)) = a;
+        match method {
+            Method::Voronoi => Ok(JobSpec::Voronoi(LayoutSpec { anchors, options: MapOptions::default() })),
+            Method::Greedy => Ok(JobSpec::Greedy(LayoutSpec { anchors, options: MapOptions::default() })),
+            Method::Homology => Ok(JobSpec::Homology(HomologySpec {
+                anchors,
+                features: Vec::new(),
+                options: HomologyOptions::default(),
+            })),
+            Method::Quad => Err(InputError::Spec("a quad job needs a spec (`--spec`)".into()).into()),
+        }
     }
 
-    /// Checks the spec against the meshes: same genus, closed surfaces, anchors in range and
-    /// distinct, enough anchors. Returns the anchors as vertex pairs.
+    pub fn method(&self) -> Method {
+        match self {
+            JobSpec::Voronoi(_) => Method::Voronoi,
+            JobSpec::Greedy(_) => Method::Greedy,
+            JobSpec::Homology(_) => Method::Homology,
+            JobSpec::Quad(_) => Method::Quad,
+        }
+    }
+
+    /// The spec as JSON (what the store keeps; [`JobSpec::from_json`] reads it back as is).
     ///
     /// # Errors
-    /// `InputError::TopologyMismatch`, `InputError::Anchors`.
-    pub fn validate(&self, source: &Mesh, target: &Mesh) -> Result<Vec<(VertexId, VertexId)>> {
-        self.check(&topology::summary(source), &topology::summary(target))
-    }
-
-    /// The feature curves, checked against both meshes: vertex paths along edges, simple,
-    /// pairwise disjoint, open ones off the boundary, closed ones whole boundary loops.
-    ///
-    /// # Errors
-    /// `InputError::Features` naming the curve and the fault.
-    pub fn curves(&self, source: &Mesh, target: &Mesh) -> Result<(Vec<Curve>, Vec<Curve>)> {
-        let mut s = Vec::with_capacity(self.features.len());
-        let mut t = Vec::with_capacity(self.features.len());
-        for (i, f) in self.features.iter().enumerate() {
-            s.push(validate_curve(source, &f.source, &format!("feature {i} (source)"))?);
-            t.push(validate_curve(target, &f.target, &format!("feature {i} (target)"))?);
-        }
-        check_disjoint(&s, source.n_vertices(), "source")?;
-        check_disjoint(&t, target.n_vertices(), "target")?;
-        Ok((s, t))
-    }
-
-    /// [`JobSpec::validate`] from the meshes' summaries alone, so a server can answer before
-    /// it queues a job without rebuilding the meshes.
-    ///
-    /// # Errors
-    /// `InputError::TopologyMismatch`, `InputError::Anchors`.
-    pub fn check(&self, ss: &topology::Summary, ts: &topology::Summary) -> Result<Vec<(VertexId, VertexId)>> {
-        if ss.components != 1 || ts.components != 1 {
-            return Err(InputError::TopologyMismatch(format!(
-                "both meshes must be connected (source has {} components, target {})",
-                ss.components, ts.components
-            ))
-            .into());
-        }
-        if ss.genus != ts.genus {
-            return Err(InputError::TopologyMismatch(format!(
-                "genus mismatch: source has genus {}, target genus {}",
-                ss.genus, ts.genus
-            ))
-            .into());
-        }
-        if ss.boundary_loops != ts.boundary_loops {
-            return Err(InputError::TopologyMismatch(format!(
-                "boundary mismatch: source has {} boundary loops, target {}",
-                ss.boundary_loops, ts.boundary_loops
-            ))
-            .into());
-        }
-        let curves = self.features.len() + ss.boundary_loops;
-        if self.method != Method::Homology && !self.features.is_empty() {
-            return Err(InputError::Features(format!(
-                "method {} takes no feature curves (method homology does)",
-                self.method.name()
-            ))
-            .into());
-        }
-        if ss.boundary_loops > 0 && ss.genus > 0 {
-            return Err(InputError::TopologyMismatch(format!(
-                "boundary loops are supported on genus-0 surfaces (features on closed surfaces of any genus); these have genus {} and {} boundary loops",
-                ss.genus, ss.boundary_loops
-            ))
-            .into());
-        }
-        if ss.boundary_loops != 0 && self.method != Method::Homology {
-            return Err(InputError::TopologyMismatch(format!(
-                "method {} maps closed surfaces; source has {} boundary loops, target {}",
-                self.method.name(),
-                ss.boundary_loops,
-                ts.boundary_loops
-            ))
-            .into());
-        }
-        let n = self.anchors.len();
-        self.options.check_ranges()?;
-        if self.features.len() > MAX_FEATURES {
-            return Err(InputError::Features(format!(
-                "{} feature curves exceed the limit {MAX_FEATURES}",
-                self.features.len()
-            ))
-            .into());
-        }
-        if n > MAX_ANCHORS {
-            return Err(InputError::Anchors(format!("{n} anchors exceed the limit {MAX_ANCHORS}")).into());
-        }
-        let need = match (self.method, ss.genus) {
-            (Method::Homology, 0) if curves == 0 => {
-                return Err(InputError::TopologyMismatch(
-                    "method homology on a closed genus-0 surface needs feature curves: each becomes a handle".into(),
-                )
-                .into());
-            }
-            // A disk without features: the anchor fixes where its boundary starts.
-            (Method::Homology, 0) if self.features.is_empty() => 1,
-            (Method::Homology, 0) => 0,
-            // The base vertex of both canonical bases.
-            (Method::Homology, _) => 1,
-            (_, 0) => 3,
-            _ => 6,
-        };
-        if n < need {
-            return Err(InputError::Anchors(format!(
-                "too few anchors: {n} given, method {} on genus {} needs at least {need}",
-                self.method.name(),
-                ss.genus
-            ))
-            .into());
-        }
-        let mut out = Vec::with_capacity(n);
-        let (mut seen_s, mut seen_t) = (std::collections::HashMap::new(), std::collections::HashMap::new());
-        for (i, &[s, t]) in self.anchors.iter().enumerate() {
-            if s >= ss.vertices as u64 {
-                return Err(InputError::Anchors(format!(
-                    "anchor {i}: source vertex {s} is out of range (source has {} vertices)",
-                    ss.vertices
-                ))
-                .into());
-            }
-            if t >= ts.vertices as u64 {
-                return Err(InputError::Anchors(format!(
-                    "anchor {i}: target vertex {t} is out of range (target has {} vertices)",
-                    ts.vertices
-                ))
-                .into());
-            }
-            if let Some(j) = seen_s.insert(s, i) {
-                return Err(InputError::Anchors(format!("anchors {j} and {i} repeat source vertex {s}")).into());
-            }
-            if let Some(j) = seen_t.insert(t, i) {
-                return Err(InputError::Anchors(format!("anchors {j} and {i} repeat target vertex {t}")).into());
-            }
-            out.push((VertexId(s as u32), VertexId(t as u32)));
-        }
-        Ok(out)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::mesh::shapes;
-
-    #[test]
-    fn a_negative_area_weight_is_a_spec_error() {
-        let m = shapes::icosphere(1);
-        let mut spec = JobSpec {
-            method: Method::Voronoi,
-            anchors: vec![[0, 0], [3, 3], [7, 7]],
-            features: Vec::new(),
-            options: MapOptions::default(),
-        };
-        assert!(spec.validate(&m, &m).is_ok());
-        spec.options.smoothing.area_weight = -1.0;
-        let e = spec.validate(&m, &m).unwrap_err();
-        assert_eq!(e.code(), "option_out_of_range", "{e}");
-        assert!(e.to_string().contains("area_weight"), "{e}");
-    }
-
-    #[test]
-    fn newton_options_out_of_range_are_spec_errors() {
-        let m = shapes::icosphere(1);
-        let spec = JobSpec {
-            method: Method::Voronoi,
-            anchors: vec![[0, 0], [3, 3], [7, 7]],
-            features: Vec::new(),
-            options: MapOptions::default(),
-        };
-        type Set = fn(&mut crate::crossparam::newton::NewtonOptions);
-        let cases: [(&str, Set); 4] = [
-            ("tolerance", |o| o.tolerance = f64::NAN),
-            ("max_move", |o| o.max_move = 0.0),
-            ("max_density", |o| o.max_density = -1.0),
-            ("min_cos", |o| o.min_cos = 2.0),
-        ];
-        for (name, set) in cases {
-            let mut bad = spec.clone();
-            set(&mut bad.options.newton);
-            let e = bad.validate(&m, &m).unwrap_err();
-            assert_eq!(e.code(), "option_out_of_range", "{e}");
-            assert!(e.to_string().contains(name), "{name}: {e}");
-        }
+    /// `Internal` if serialization fails.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string(self).map_err(|e| Error::Internal(e.to_string()))
     }
 }

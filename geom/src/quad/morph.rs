@@ -6,7 +6,25 @@
 use super::remesh::RemeshGrid;
 use super::wavelet;
 use crate::mesh::P3;
-use crate::pipeline::{Interpolation, LevelSchedule};
+use serde::{Deserialize, Serialize};
+
+/// Interpolation in time between consecutive models.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Interpolation {
+    #[default]
+    Linear,
+    /// Cubic Hermite through the models (Catmull–Rom tangents, zero at the ends).
+    Spline,
+}
+
+/// When one wavelet level starts to blend (time in [0, 1]) and how fast (1 = over the whole morph).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LevelSchedule {
+    pub start: f64,
+    pub speed: f64,
+}
 
 /// Model segment and local time of global time `t` in [0, 1] through `n` models.
 fn segment(t: f64, n: usize) -> (usize, f64) {

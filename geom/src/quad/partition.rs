@@ -8,8 +8,8 @@
 use super::layout::{QuadLayout, SQUARE};
 use crate::error::{Error, InputError, Result};
 use crate::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
-use crate::homology::cut::{cut_along, path_edges};
-use crate::homology::refine::Refined;
+use crate::mesh::cut::{cut_along, path_edges};
+use crate::mesh::refine::Refined;
 use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::param::{Uv, disk_boundary};
 use crate::topology::components;
@@ -225,7 +225,7 @@ fn finish(
 #[allow(clippy::too_many_arguments)]
 fn extract_patch(
     mesh: &Mesh,
-    cut: &crate::homology::cut::CutMesh,
+    cut: &crate::mesh::cut::CutMesh,
     face_label: &[u32],
     label: u32,
     corners: [VertexId; 4],

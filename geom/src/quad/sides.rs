@@ -14,7 +14,7 @@
 
 use crate::error::Result;
 use crate::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
-use crate::homology::cut::path_edges;
+use crate::mesh::cut::path_edges;
 use crate::mesh::{Mesh, VertexId};
 
 /// Per face: true on the left of the loop (the side of patch 0).

@@ -30,11 +30,7 @@ pub struct ParamState {
     rng: Pcg64Mcg,
 }
 
-/// Signed parameter area of `[a, b, c]`, doubled.
-#[inline]
-pub fn area2(a: Uv, b: Uv, c: Uv) -> f64 {
-    (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])
-}
+pub use crate::planar::area2;
 
 /// `(|S_s|², |S_t|², S_s·S_t)` of a positively oriented triangle ([`param::stretch_jacobian`]).
 #[inline]

@@ -5,9 +5,9 @@
 //! ([`super::tri_quads::TriQuadSurface`]).
 
 use super::partition::PatchMesh;
-use crate::crossparam::locate2d::Grid;
 use crate::mesh::{Mesh, P3, V3};
 use crate::param::Uv;
+use crate::planar::locate::Grid;
 
 /// One model's quads.
 pub trait QuadSurface: Sync {

@@ -12,7 +12,6 @@
 use super::layout::{QuadLayout, QuadPatchLayout, QuadSide};
 use super::stretch::{ParamState, PatchSoup, StretchOptOptions, mesh_stretch};
 use super::surface::{QuadSurface, interpolate, vertex_normals};
-use crate::crossparam::locate2d::{Grid, barycentric};
 use crate::crossparam::{PatchParam, PatchParamOptions, TRIANGLE, parameterize_patches};
 use crate::domain::refine::{Refined, refine};
 use crate::domain::tracer::Tracer;
@@ -20,6 +19,7 @@ use crate::domain::{LayoutOptions, Patch, patches_of, straighten::straighten, vo
 use crate::error::{Error, InputError, Result};
 use crate::mesh::{Mesh, P3, V3, VertexId};
 use crate::param::Uv;
+use crate::planar::locate::{Grid, barycentric};
 use crate::progress::Progress;
 
 /// One model: its refined mesh and its triangle parameterizations.

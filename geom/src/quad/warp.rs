@@ -13,9 +13,9 @@
 
 use super::kernel::kernel_centroid;
 use super::stretch::{ParamState, StretchOptOptions, area2};
-use crate::crossparam::locate2d::barycentric;
 use crate::error::{Error, Result};
 use crate::param::Uv;
+use crate::planar::locate::barycentric;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 /// The features move to their targets in this many equal steps, the carried vertices relaxed

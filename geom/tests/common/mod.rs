@@ -55,7 +55,7 @@ pub fn shuffled(m: &Mesh) -> (Mesh, Vec<u32>) {
 /// midpoints. Vertex `i` of `m` is vertex `i` of the copy (the ground truth is the identity on
 /// them); the new vertices follow.
 pub fn subdivided(m: &Mesh) -> Mesh {
-    geom::homology::refine::Refined::identity(m).subdivide().unwrap().mesh
+    geom::mesh::refine::Refined::identity(m).subdivide().unwrap().mesh
 }
 
 /// A vertex path of `m` on its subdivision `fine` ([`subdivided`]): each edge through its midpoint.

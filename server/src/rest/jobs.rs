@@ -3,7 +3,7 @@
 use super::{Owner, P, Q, is_multipart, multipart_error, read_limited, reserve_upload};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
-use crate::service::{format_hint, job_filter};
+use crate::service::{SpecInput, format_hint, job_filter};
 use crate::views::{JobPage, JobView, SubmitJob, SubmitJobRequest, job_view};
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
@@ -80,7 +80,8 @@ pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Re
         let mp = Multipart::from_request(req, &st)
             .await
             .map_err(|e| ApiError::bad_request("invalid_multipart", e.body_text()))?;
-        multipart_job(&st, &owner, mp).await?
+        let (meshes, spec) = multipart_job(&st, &owner, mp).await?;
+        (meshes, SpecInput::Bytes(spec))
     } else {
         let (parts, body) = req.into_parts();
         // A JSON job carries ids and a spec, never mesh bytes: its own small limit, checked
@@ -102,9 +103,9 @@ pub async fn submit_job(State(st): State<AppState>, Owner(owner): Owner, req: Re
                 ));
             }
         };
-        (meshes, serde_json::to_vec(&s.spec).map_err(ApiError::internal)?)
+        (meshes, SpecInput::Json(s.spec))
     };
-    let (job, created) = st.service.submit(&owner, &meshes, &spec, key).await?;
+    let (job, created) = st.service.submit(&owner, &meshes, spec, key).await?;
     let mut headers = HeaderMap::new();
     if let Ok(v) = HeaderValue::from_str(&format!("/v1/jobs/{}", job.id)) {
         headers.insert(header::LOCATION, v);

@@ -12,10 +12,10 @@
 //! point several chains reach the same patch, one per sheet.
 
 use super::super::TRIANGLE;
-use super::super::locate2d::barycentric;
 use crate::domain::Patch;
 use crate::error::{Error, Result};
 use crate::param::Uv;
+use crate::planar::locate::barycentric;
 
 /// An affine map of the plane, `x -> m x + t`.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -3,11 +3,11 @@
 //! patch), indexed by [`Grid`]. A triangle may straddle patch sides, since the global map lets
 //! vertices cross them.
 
-use super::super::locate2d::{Grid, barycentric};
 use super::charts::Charts;
 use super::solve::{Rows, State};
 use crate::mesh::{FaceId, Mesh};
 use crate::param::Uv;
+use crate::planar::locate::{Grid, barycentric};
 
 /// How far outside a patch's triangle another triangle may lie and still be indexed, in
 /// barycentric coordinates of the patch's triangle.
@@ -80,7 +80,7 @@ fn patch_locator(
         let r = (0..3).find(|&k| !fixed[t[k].idx()]).unwrap_or(0);
         let Some(a) = charts.transition_near_patch(st.patch[t[r].idx()], p, q[r]) else { continue };
         let q = q.map(|x| a.apply(x));
-        let area2 = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
+        let area2 = crate::planar::area2(q[0], q[1], q[2]);
         if area2 <= 0.0 || !reaches_triangle(charts, p, q) {
             continue;
         }

@@ -1,7 +1,7 @@
 //! The files a mapping job produces, as bytes: re-embedded meshes, maps as CSV, the layout as
 //! JSON and the refined meshes as PLY with a patch id and a colour per face.
 
-use super::run::{Artifact, MapResult};
+use super::Artifact;
 use crate::domain::Patch;
 use crate::domain::refine::Refined;
 use crate::domain::tracer::Tracer;
@@ -56,7 +56,7 @@ pub fn map_artifacts(
     patches: &[Patch],
     rs: &Refined,
     rt: &Refined,
-    result: &MapResult,
+    maps: (&SurfaceMap, &SurfaceMap),
     on_target: &Mesh,
     on_source: &Mesh,
 ) -> Result<Vec<Artifact>> {
@@ -77,7 +77,7 @@ pub fn map_artifacts(
     let layout = serde_json::to_vec_pretty(&layout).map_err(|e| Error::Internal(e.to_string()))?;
     // The large encodings are independent: build them on the thread pool.
     let (mut arts, (ply_s, ply_t)) = rayon::join(
-        || maps_and_meshes(&result.source_to_target, &result.target_to_source, on_target, on_source),
+        || maps_and_meshes(maps.0, maps.1, on_target, on_source),
         || rayon::join(|| layout_ply(rs), || layout_ply(rt)),
     );
     arts.extend([

@@ -1,14 +1,14 @@
-//! `run_remesh`: the `quad` job over N meshes. Partition -> consistent parameterization ->
+//! `quad`: the job over N meshes. Partition -> consistent parameterization ->
 //! uniform or adaptive remesh -> geometry images and normal maps -> morphs -> metrics, with
 //! progress, cancellation and per-stage timings.
 
-use super::remesh_spec::{MorphDomain, RemeshSpec};
-use super::run::{Artifact, Clock};
+use super::common::{Artifact, Clock, json_artifact};
+use super::quad_spec::{MorphDomain, QuadSpec};
 use crate::error::{Error, Result};
 use crate::io::{self, Format};
 use crate::mesh::{Mesh, P3};
 use crate::metrics::hausdorff;
-use crate::progress::Progress;
+use crate::progress::{Progress, Stage};
 use crate::quad::consistent::{ConsistentOptions, ConsistentResult, consistent_parameterization};
 use crate::quad::remesh::{RemeshGrid, sample_uniform, sample_with_normals, uniform_grid};
 use crate::quad::stretch::PatchSoup;
@@ -17,7 +17,6 @@ use crate::quad::{PartitionOptions, QuadLayout, QuadParamOptions, adaptive, morp
 use crate::topology;
 use serde::Serialize;
 use serde_json::json;
-use std::time::Instant;
 
 /// One patch of one model.
 #[derive(Debug, Clone, Serialize)]
@@ -55,7 +54,7 @@ pub struct ModelReport {
 
 /// What a `quad` job measured (also written as `metrics.json`).
 #[derive(Debug, Clone, Serialize)]
-pub struct RemeshReport {
+pub struct QuadReport {
     pub method: &'static str,
     pub models: usize,
     pub level: u32,
@@ -193,12 +192,8 @@ fn build_tri(tq: &tri_quads::TriQuads, rows: usize) -> Built<'_> {
 ///
 /// # Errors
 /// Input errors of the spec and meshes, layout conflicts, numerical failures, `Cancelled`.
-pub fn run_remesh(
-    spec: &RemeshSpec,
-    meshes: &[Mesh],
-    progress: &mut dyn Progress,
-) -> Result<(RemeshReport, Vec<Artifact>)> {
-    let mut clock = Clock(Instant::now(), Vec::new());
+pub fn run(spec: &QuadSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Result<(QuadReport, Vec<Artifact>)> {
+    let mut clock = Clock::start();
     let summaries: Vec<_> = meshes.iter().map(topology::summary).collect();
     let rows = spec.check(&summaries)?;
     let o = &spec.options;
@@ -219,31 +214,31 @@ pub fn run_remesh(
     };
     clock.lap("parameterize");
     progress.check()?;
-    progress.report(crate::progress::Stage::Remesh, 0.0);
+    progress.report(Stage::Remesh, 0.0);
     let rm = remesh_all(&built, o.level, o.adaptive_epsilon, meshes)?;
     clock.lap("remesh");
     let mut arts = Vec::new();
     let image_level = o.image_level.unwrap_or(o.level.min(8));
     if image_level > 0 {
         progress.check()?;
-        progress.report(crate::progress::Stage::Images, 0.0);
+        progress.report(Stage::Images, 0.0);
         arts.extend(geometry_images(&built, image_level)?);
         clock.lap("images");
     }
     progress.check()?;
-    progress.report(crate::progress::Stage::Metrics, 0.0);
+    progress.report(Stage::Metrics, 0.0);
     let mut per_model = Vec::with_capacity(meshes.len());
     for (m, mesh) in meshes.iter().enumerate() {
         progress.check()?;
-        progress.report(crate::progress::Stage::Metrics, m as f64 / meshes.len() as f64);
+        progress.report(Stage::Metrics, m as f64 / meshes.len() as f64);
         per_model.push(model_report(&built, m, mesh, &rm, o.metric_samples)?);
     }
     clock.lap("metrics");
-    progress.report(crate::progress::Stage::Morph, 0.0);
+    progress.report(Stage::Morph, 0.0);
     arts.extend(mesh_artifacts(&built, &rm)?);
     arts.extend(morph_artifacts(spec, &rm)?);
     clock.lap("artifacts");
-    let report = RemeshReport {
+    let report = QuadReport {
         method: "quad",
         models: meshes.len(),
         level: o.level,
@@ -255,11 +250,10 @@ pub fn run_remesh(
         remesh_faces: rm.faces.len(),
         remesh_quads: rm.quads,
         per_model,
-        timings_ms: clock.1,
+        timings_ms: clock.finish(),
     };
-    let json = serde_json::to_vec_pretty(&report).map_err(|e| Error::Internal(e.to_string()))?;
-    arts.push(Artifact { name: "metrics.json".into(), content_type: "application/json", bytes: json });
-    progress.report(crate::progress::Stage::Done, 1.0);
+    arts.push(json_artifact("metrics.json", &report)?);
+    progress.report(Stage::Done, 1.0);
     Ok((report, arts))
 }
 
@@ -370,7 +364,7 @@ fn geometry_images(b: &Built, level: u32) -> Result<Vec<Artifact>> {
     Ok(arts)
 }
 
-fn morph_artifacts(spec: &RemeshSpec, rm: &Remeshes) -> Result<Vec<Artifact>> {
+fn morph_artifacts(spec: &QuadSpec, rm: &Remeshes) -> Result<Vec<Artifact>> {
     let mo = &spec.options.morph;
     let targets: Vec<(String, Vec<P3>)> =
         rm.positions[1..].iter().enumerate().map(|(k, p)| (format!("model_{}", k + 1), p.clone())).collect();

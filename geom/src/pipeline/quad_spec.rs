@@ -1,33 +1,14 @@
 //! The spec of a `quad` job over N meshes (`surfmap remesh`, the server's N-mesh jobs):
-//! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}`, validated against
-//! the meshes before any work starts. The first four anchor rows are the partition points, the
+//! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}` (the `quad` variant
+//! of [`super::JobSpec`]), validated against the meshes before any work starts. The first four anchor rows are the partition points, the
 //! rest (and `options.feature_anchors`) are feature points.
 
+use super::limits::{MAX_ANCHORS, MAX_MODELS};
 use crate::error::{InputError, Result};
 use crate::mesh::VertexId;
+pub use crate::quad::morph::{Interpolation, LevelSchedule};
 use crate::topology;
 use serde::{Deserialize, Serialize};
-
-/// Most models one job may remesh together.
-pub const MAX_MODELS: usize = 16;
-
-/// The only method of a remesh job.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum QuadMethod {
-    /// Consistent quad parameterization (Yu & Chuang).
-    Quad,
-}
-
-/// Interpolation in time between consecutive models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum Interpolation {
-    #[default]
-    Linear,
-    /// Cubic Hermite through the models (Catmull–Rom tangents, zero at the ends).
-    Spline,
-}
 
 /// Where the morph interpolates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -37,14 +18,6 @@ pub enum MorphDomain {
     Spatial,
     /// Lifting-wavelet coefficients, each level on its own schedule.
     Wavelet,
-}
-
-/// When one wavelet level starts to blend (time in [0, 1]) and how fast (1 = over the whole morph).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LevelSchedule {
-    pub start: f64,
-    pub speed: f64,
 }
 
 /// Morph outputs: `morph.glb` always; OBJ frames when `frames > 0`; one OBJ per weight vector.
@@ -99,22 +72,13 @@ impl Default for QuadOptions {
 /// A `quad` job.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct RemeshSpec {
-    pub method: QuadMethod,
+pub struct QuadSpec {
     pub anchors: Vec<Vec<u64>>,
     #[serde(default)]
     pub options: QuadOptions,
 }
 
-impl RemeshSpec {
-    /// Parses a spec from JSON.
-    ///
-    /// # Errors
-    /// `InputError::Spec` naming the field at fault.
-    pub fn from_json(bytes: &[u8]) -> Result<RemeshSpec> {
-        serde_json::from_slice(bytes).map_err(|e| InputError::Spec(e.to_string()).into())
-    }
-
+impl QuadSpec {
     /// Checks the spec against the models' summaries: 1..=16 connected closed meshes of one
     /// genus, rows one vertex per model, in range, no vertex used twice on one model.
     /// Returns all rows (partition points first, then features) as vertex ids.
@@ -160,13 +124,10 @@ impl RemeshSpec {
             ))
             .into());
         }
-        if rows.len() > super::MAX_ANCHORS {
-            return Err(InputError::Anchors(format!(
-                "{} anchor rows exceed the limit {}",
-                rows.len(),
-                super::MAX_ANCHORS
-            ))
-            .into());
+        if rows.len() > MAX_ANCHORS {
+            return Err(
+                InputError::Anchors(format!("{} anchor rows exceed the limit {}", rows.len(), MAX_ANCHORS)).into()
+            );
         }
         let mut seen = vec![std::collections::HashMap::new(); n];
         let mut out = Vec::with_capacity(rows.len());

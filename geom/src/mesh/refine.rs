@@ -1,4 +1,4 @@
-//! Geometry-preserving refinement for the homology method: edges split at their midpoints, so
+//! Geometry-preserving refinement (used by `homology` and `quad`): edges split at their midpoints, so
 //! every refined face lies flat inside one original face. Each refined face remembers that face
 //! and the barycentric coordinates of its corners there, so a point found on the refined mesh
 //! converts exactly to a point on the original mesh.

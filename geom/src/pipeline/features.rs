@@ -3,12 +3,10 @@
 //! domains -> maps both ways -> anchor snapping -> smoothing with every feature vertex held ->
 //! metrics (with the feature error) -> artifacts.
 
-use super::artifacts;
-use super::run::{Artifact, Clock, MapReport};
-use super::run_homology::{
-    finish_pair, finish_report, json_artifact, loops_json, meta_outputs, morph_glb, pair_report, planar_obj,
-};
-use super::spec::JobSpec;
+use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, morph_glb, planar_obj};
+use super::common::relax::finish_pair;
+use super::common::{Artifact, Clock, PairReport, artifacts, json_artifact};
+use super::spec::HomologySpec;
 use crate::error::Result;
 use crate::homology::CanonicalBasisResult;
 use crate::homology::curve_align::CurveAlignOptions;
@@ -16,9 +14,17 @@ use crate::homology::feature_cut::{FeatureCutResult, Side, SideKind};
 use crate::homology::feature_map::{FeatureMapOptions, FeatureSide, feature_error, feature_map};
 use crate::homology::features::{Curve, CurveKind};
 use crate::mesh::{Mesh, VertexId};
-use crate::progress::Progress;
+use crate::progress::{Progress, Stage};
 use serde::Serialize;
 use serde_json::json;
+
+/// What a `homology` job with feature curves or boundaries measured (`metrics.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct FeatureMapReport {
+    #[serde(flatten)]
+    pub pair: PairReport,
+    pub features: FeatureReport,
+}
 
 /// What a feature job adds to `metrics.json`.
 #[derive(Debug, Clone, Serialize)]
@@ -50,28 +56,35 @@ pub struct FeatureReport {
     pub domain_flips: [usize; 2],
     /// Meta-mesh vertices, faces and edge crossings, when asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub meta_mesh: Option<super::run_homology::MetaMeshStats>,
+    pub meta_mesh: Option<MetaMeshStats>,
 }
 
-/// Runs a feature job (called by `run_homology` when the spec has features or the meshes have
-/// boundary loops).
+/// Whether a `homology` job maps feature curves: it has some, or its meshes have boundaries.
+pub fn applies(spec: &HomologySpec, source: &Mesh) -> bool {
+    !spec.features.is_empty() || !crate::topology::boundary_loops(source).is_empty()
+}
+
+/// Runs a `homology` job with feature curves or boundary loops.
 ///
 /// # Errors
-/// As [`super::run_map`].
-pub(super) fn run_features(
-    spec: &JobSpec,
+/// Input errors for a spec or curves that do not fit the meshes; `Numerical` when a cut or
+/// domain cannot be built; `Cancelled`.
+pub fn run(
+    spec: &HomologySpec,
     source: &Mesh,
     target: &Mesh,
-    pairs: &[(VertexId, VertexId)],
-    curves: (&[Curve], &[Curve]),
-    mut clock: Clock,
     progress: &mut dyn Progress,
-) -> Result<(MapReport, Vec<Artifact>)> {
+) -> Result<(FeatureMapReport, Vec<Artifact>)> {
+    let mut clock = Clock::start();
+    let pairs = &spec.validate(source, target)?;
+    let (sc, tc) = spec.curves(source, target)?;
+    let curves: (&[Curve], &[Curve]) = (&sc, &tc);
     let o = &spec.options;
     clock.lap("setup");
-    progress.report(crate::progress::Stage::FeatureCut, 0.0);
+    progress.report(Stage::FeatureCut, 0.0);
     let fo = FeatureMapOptions {
-        stretch_iterations: o.domain_stretch_iterations,
+        // As in `homology`: no reweighting of the planar domains.
+        stretch_iterations: 0,
         align: o.align_curves.then(CurveAlignOptions::default),
         basis: o.basis,
         rotation: o.rotation,
@@ -90,7 +103,15 @@ pub(super) fn run_features(
         open.chain(ends).chain(starts).filter(|v| v.idx() < n).collect()
     };
     let (hs, ht) = (held(&r.source.cut, source.n_vertices()), held(&r.target.cut, target.n_vertices()));
-    let f = finish_pair(source, target, (&r.source_to_target, &r.target_to_source), pairs, (&hs, &ht), o, progress)?;
+    let f = finish_pair(
+        source,
+        target,
+        (&r.source_to_target, &r.target_to_source),
+        pairs,
+        (&hs, &ht),
+        &o.relax(),
+        progress,
+    )?;
     clock.lap("smooth_metrics");
     progress.check()?;
     // The feature error on the meshes' own curves (the cut's may run through a refinement;
@@ -116,11 +137,11 @@ pub(super) fn run_features(
     let mut arts = artifacts::maps_and_meshes(&f.s2t, &f.t2s, &f.on_target, &f.on_source);
     let mut morph = None;
     if o.meta_mesh {
-        progress.report(crate::progress::Stage::MetaMesh, 0.0);
+        progress.report(Stage::MetaMesh, 0.0);
         // On a refinement (same surface, more vertices) when the cut lives on one.
         let (ms, mt) = (r.source.cut_mesh(source), r.target.cut_mesh(target));
         let m = crate::homology::feature_overlay::feature_meta_mesh(&r.source, &r.target, ms, mt);
-        let (stats, m) = meta_outputs(m, o, &mut arts);
+        let (stats, m) = meta_outputs(m, o.dihedral_threshold_deg, &mut arts);
         report_f.meta_mesh = Some(stats);
         morph = m;
         clock.lap("meta_mesh");
@@ -130,13 +151,14 @@ pub(super) fn run_features(
     let (bs, bt) = (r.handles.as_ref().map(|h| &h.source), r.handles.as_ref().map(|h| &h.target));
     arts.push(json_artifact("basis_source.json", &cut_json(&r.source, source, bs))?);
     arts.push(json_artifact("basis_target.json", &cut_json(&r.target, target, bt))?);
-    arts.push(Artifact { name: "domain_source.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.source)? });
-    arts.push(Artifact { name: "domain_target.obj".into(), content_type: "model/obj", bytes: domain_obj(&r.target)? });
+    arts.push(planar_obj("domain_source.obj", &r.source.domain.uv, &r.source.cut.disk.mesh)?);
+    arts.push(planar_obj("domain_target.obj", &r.target.domain.uv, &r.target.cut.disk.mesh)?);
     clock.lap("artifacts");
-    let mut report = pair_report(spec, pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
-    report.features = Some(report_f);
-    finish_report(&mut report, clock, &mut arts)?;
-    progress.report(crate::progress::Stage::Done, 1.0);
+    let pair = PairReport::new("homology", pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
+    let mut report = FeatureMapReport { pair, features: report_f };
+    report.pair.timings_ms = clock.finish();
+    arts.push(json_artifact("metrics.json", &report)?);
+    progress.report(Stage::Done, 1.0);
     Ok((report, arts))
 }
 
@@ -191,9 +213,4 @@ fn cut_json(fs: &FeatureSide, mesh: &Mesh, handles: Option<&CanonicalBasisResult
         "word": word(c, handles),
         "disk_euler_characteristic": crate::topology::euler_characteristic(&c.disk.mesh),
     })
-}
-
-/// The planar disk as a mesh at z = 0.
-fn domain_obj(fs: &FeatureSide) -> Result<Vec<u8>> {
-    planar_obj(&fs.domain.uv, &fs.cut.disk.mesh)
 }

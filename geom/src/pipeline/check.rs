@@ -1,0 +1,239 @@
+//! A job checked against its meshes' summaries before any work starts (the server answers
+//! with these errors before it queues a job; the pipeline checks again on the meshes).
+
+use super::limits::{MAX_ANCHORS, MAX_FEATURES};
+use super::spec::{HomologySpec, JobSpec, LayoutSpec, Method};
+use crate::error::{InputError, Result};
+use crate::homology::features::{Curve, check_disjoint, validate_curve};
+use crate::mesh::{Mesh, VertexId};
+use crate::topology::{self, Summary};
+
+impl JobSpec {
+    /// Checks the job against its meshes' summaries (two for pair jobs, in source, target
+    /// order; 1 to 16 for `quad`).
+    ///
+    /// # Errors
+    /// `InputError::Spec` for the wrong number of meshes; the method's own checks.
+    pub fn check(&self, summaries: &[Summary]) -> Result<()> {
+        let pair = |n: usize| -> Result<(&Summary, &Summary)> {
+            match summaries {
+                [a, b] => Ok((a, b)),
+                _ => Err(InputError::Spec(format!(
+                    "method {} maps a source onto a target: 2 meshes, got {n}",
+                    self.method().name()
+                ))
+                .into()),
+            }
+        };
+        match self {
+            JobSpec::Voronoi(s) | JobSpec::Greedy(s) => {
+                let (a, b) = pair(summaries.len())?;
+                s.check(self.method(), a, b).map(|_| ())
+            }
+            JobSpec::Homology(s) => {
+                let (a, b) = pair(summaries.len())?;
+                s.check(a, b).map(|_| ())
+            }
+            JobSpec::Quad(s) => s.check(summaries).map(|_| ()),
+        }
+    }
+}
+
+impl LayoutSpec {
+    /// Closed connected meshes of one genus, options in range, enough anchors (3 on genus 0,
+    /// 6 above), in range and distinct. Returns the anchors as vertex pairs.
+    ///
+    /// # Errors
+    /// `InputError::TopologyMismatch`, `InputError::Anchors`, `InputError::OptionRange`.
+    pub fn check(&self, method: Method, ss: &Summary, ts: &Summary) -> Result<Vec<(VertexId, VertexId)>> {
+        same_topology(ss, ts)?;
+        if ss.boundary_loops != 0 {
+            return Err(InputError::TopologyMismatch(format!(
+                "method {} maps closed surfaces; source has {} boundary loops, target {} (method homology maps genus-0 surfaces with boundaries)",
+                method.name(),
+                ss.boundary_loops,
+                ts.boundary_loops
+            ))
+            .into());
+        }
+        self.options.check_ranges()?;
+        let need = if ss.genus == 0 { 3 } else { 6 };
+        anchor_pairs(&self.anchors, method, need, ss, ts)
+    }
+
+    /// [`LayoutSpec::check`] on the meshes themselves.
+    ///
+    /// # Errors
+    /// As [`LayoutSpec::check`].
+    pub fn validate(&self, method: Method, source: &Mesh, target: &Mesh) -> Result<Vec<(VertexId, VertexId)>> {
+        self.check(method, &topology::summary(source), &topology::summary(target))
+    }
+}
+
+impl HomologySpec {
+    /// Connected meshes of one genus and boundary count (boundaries on genus 0 only), options
+    /// in range, feature curves within the limit, the anchors the domain needs. Returns the
+    /// anchors as vertex pairs.
+    ///
+    /// # Errors
+    /// `InputError::TopologyMismatch`, `InputError::Anchors`, `InputError::Features`,
+    /// `InputError::OptionRange`.
+    pub fn check(&self, ss: &Summary, ts: &Summary) -> Result<Vec<(VertexId, VertexId)>> {
+        same_topology(ss, ts)?;
+        if ss.boundary_loops > 0 && ss.genus > 0 {
+            return Err(InputError::TopologyMismatch(format!(
+                "boundary loops are supported on genus-0 surfaces (features on closed surfaces of any genus); these have genus {} and {} boundary loops",
+                ss.genus, ss.boundary_loops
+            ))
+            .into());
+        }
+        self.options.check_ranges()?;
+        if self.features.len() > MAX_FEATURES {
+            return Err(InputError::Features(format!(
+                "{} feature curves exceed the limit {MAX_FEATURES}",
+                self.features.len()
+            ))
+            .into());
+        }
+        let curves = self.features.len() + ss.boundary_loops;
+        let need = match ss.genus {
+            0 if curves == 0 => {
+                return Err(InputError::TopologyMismatch(
+                    "method homology on a closed genus-0 surface needs feature curves: each becomes a handle".into(),
+                )
+                .into());
+            }
+            // A disk without features: the anchor fixes where its boundary starts.
+            0 if self.features.is_empty() => 1,
+            0 => 0,
+            // The base vertex of both canonical bases.
+            _ => 1,
+        };
+        anchor_pairs(&self.anchors, Method::Homology, need, ss, ts)
+    }
+
+    /// [`HomologySpec::check`] on the meshes themselves.
+    ///
+    /// # Errors
+    /// As [`HomologySpec::check`].
+    pub fn validate(&self, source: &Mesh, target: &Mesh) -> Result<Vec<(VertexId, VertexId)>> {
+        self.check(&topology::summary(source), &topology::summary(target))
+    }
+
+    /// The feature curves, checked against both meshes: vertex paths along edges, simple,
+    /// pairwise disjoint, open ones off the boundary, closed ones whole boundary loops.
+    ///
+    /// # Errors
+    /// `InputError::Features` naming the curve and the fault.
+    pub fn curves(&self, source: &Mesh, target: &Mesh) -> Result<(Vec<Curve>, Vec<Curve>)> {
+        let mut s = Vec::with_capacity(self.features.len());
+        let mut t = Vec::with_capacity(self.features.len());
+        for (i, f) in self.features.iter().enumerate() {
+            s.push(validate_curve(source, &f.source, &format!("feature {i} (source)"))?);
+            t.push(validate_curve(target, &f.target, &format!("feature {i} (target)"))?);
+        }
+        check_disjoint(&s, source.n_vertices(), "source")?;
+        check_disjoint(&t, target.n_vertices(), "target")?;
+        Ok((s, t))
+    }
+}
+
+/// Both meshes connected, of one genus and one number of boundary loops.
+fn same_topology(ss: &Summary, ts: &Summary) -> Result<()> {
+    if ss.components != 1 || ts.components != 1 {
+        return Err(InputError::TopologyMismatch(format!(
+            "both meshes must be connected (source has {} components, target {})",
+            ss.components, ts.components
+        ))
+        .into());
+    }
+    if ss.genus != ts.genus {
+        return Err(InputError::TopologyMismatch(format!(
+            "genus mismatch: source has genus {}, target genus {}",
+            ss.genus, ts.genus
+        ))
+        .into());
+    }
+    if ss.boundary_loops != ts.boundary_loops {
+        return Err(InputError::TopologyMismatch(format!(
+            "boundary mismatch: source has {} boundary loops, target {}",
+            ss.boundary_loops, ts.boundary_loops
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// At least `need` and at most [`MAX_ANCHORS`] anchors, each in range on its mesh, no vertex
+/// used twice on one mesh.
+fn anchor_pairs(
+    anchors: &[[u64; 2]],
+    method: Method,
+    need: usize,
+    ss: &Summary,
+    ts: &Summary,
+) -> Result<Vec<(VertexId, VertexId)>> {
+    let n = anchors.len();
+    if n > MAX_ANCHORS {
+        return Err(InputError::Anchors(format!("{n} anchors exceed the limit {MAX_ANCHORS}")).into());
+    }
+    if n < need {
+        return Err(InputError::Anchors(format!(
+            "too few anchors: {n} given, method {} on genus {} needs at least {need}",
+            method.name(),
+            ss.genus
+        ))
+        .into());
+    }
+    let mut out = Vec::with_capacity(n);
+    let (mut seen_s, mut seen_t) = (std::collections::HashMap::new(), std::collections::HashMap::new());
+    for (i, &[s, t]) in anchors.iter().enumerate() {
+        if s >= ss.vertices as u64 {
+            return Err(InputError::Anchors(format!(
+                "anchor {i}: source vertex {s} is out of range (source has {} vertices)",
+                ss.vertices
+            ))
+            .into());
+        }
+        if t >= ts.vertices as u64 {
+            return Err(InputError::Anchors(format!(
+                "anchor {i}: target vertex {t} is out of range (target has {} vertices)",
+                ts.vertices
+            ))
+            .into());
+        }
+        if let Some(j) = seen_s.insert(s, i) {
+            return Err(InputError::Anchors(format!("anchors {j} and {i} repeat source vertex {s}")).into());
+        }
+        if let Some(j) = seen_t.insert(t, i) {
+            return Err(InputError::Anchors(format!("anchors {j} and {i} repeat target vertex {t}")).into());
+        }
+        out.push((VertexId(s as u32), VertexId(t as u32)));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+
+    #[test]
+    fn a_negative_smoothing_step_is_out_of_range() {
+        let m = shapes::icosphere(1);
+        let mut spec = LayoutSpec { anchors: vec![[0, 0], [3, 3], [7, 7]], options: Default::default() };
+        assert!(spec.validate(Method::Voronoi, &m, &m).is_ok());
+        spec.options.smoothing.step = -1.0;
+        let e = spec.validate(Method::Voronoi, &m, &m).unwrap_err();
+        assert_eq!(e.code(), "option_out_of_range", "{e}");
+        assert!(e.to_string().contains("smoothing.step"), "{e}");
+    }
+
+    #[test]
+    fn the_wrong_number_of_meshes_is_a_spec_error() {
+        let m = topology::summary(&shapes::icosphere(1));
+        let spec = JobSpec::Greedy(LayoutSpec { anchors: vec![[0, 0], [3, 3], [7, 7]], options: Default::default() });
+        assert!(spec.check(&[m.clone(), m.clone()]).is_ok());
+        assert_eq!(spec.check(&[m.clone(), m.clone(), m]).unwrap_err().code(), "invalid_spec");
+    }
+}

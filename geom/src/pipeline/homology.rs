@@ -1,0 +1,178 @@
+//! `homology` without feature curves: canonical bases -> fundamental domains -> maps through
+//! the 4g-gon -> anchor snapping -> relaxation -> metrics -> artifacts (bases and domains
+//! included).
+
+use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, morph_glb, planar_obj};
+use super::common::relax::finish_pair;
+use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
+use super::spec::HomologySpec;
+use crate::error::{Error, Result};
+use crate::homology::map::SideDomain;
+use crate::homology::matching::{MatchingOptions, find_matching, parse_matching, reference_frame, reference_h1};
+use crate::homology::{HomologyMapOptions, homology_map};
+use crate::mesh::Mesh;
+use crate::progress::{Progress, Stage};
+use serde::Serialize;
+use serde_json::json;
+
+/// What a `homology` job measured (`metrics.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct HomologyMapReport {
+    #[serde(flatten)]
+    pub pair: PairReport,
+    pub homology: HomologyReport,
+}
+
+/// What a `homology` job adds to `metrics.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct HomologyReport {
+    pub genus: usize,
+    pub basis: [usize; 2],
+    pub rotation: usize,
+    /// Polygon sides τ shifts by.
+    pub side_shift: usize,
+    /// Whether the source domain was warped onto the anchors (constrained mean-value map).
+    pub anchor_warp: bool,
+    /// Induced map on H1 (`a1, b1, …`), column `j` the image of source loop `j`.
+    pub h1: Vec<Vec<i32>>,
+    /// The same map read in the reference bases (basis 0 on each mesh), when other bases were
+    /// used or a matching was asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub h1_reference: Option<Vec<Vec<i32>>>,
+    /// Base vertices (the first anchor pair).
+    pub base: [u32; 2],
+    /// Subdivision rounds the bases needed.
+    pub subdivisions: [usize; 2],
+    /// Loop lengths on each mesh.
+    pub loop_lengths: [Vec<f64>; 2],
+    /// Meta-mesh vertices, faces and edge crossings, when asked for.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub meta_mesh: Option<MetaMeshStats>,
+}
+
+/// Runs a `homology` job.
+///
+/// # Errors
+/// Input errors for a spec that does not fit the meshes; `Numerical` when a basis or domain
+/// cannot be built; `Cancelled`.
+pub fn run(
+    spec: &HomologySpec,
+    source: &Mesh,
+    target: &Mesh,
+    progress: &mut dyn Progress,
+) -> Result<(HomologyMapReport, Vec<Artifact>)> {
+    let mut clock = Clock::start();
+    let pairs = spec.validate(source, target)?;
+    let o = &spec.options;
+    clock.lap("setup");
+    progress.report(Stage::Basis, 0.0);
+    let (mut basis, mut rotation, mut want) = (o.basis, o.rotation, None);
+    if let Some(entries) = &o.matching {
+        let g = crate::topology::summary(source).genus.max(0) as usize;
+        let w = parse_matching(g, entries)?;
+        let found = find_matching(source, target, pairs[0], &w, &MatchingOptions::default())?;
+        (basis, rotation, want) = (found.basis, found.rotation, Some(w));
+        clock.lap("matching");
+    }
+    let hopts = HomologyMapOptions {
+        basis,
+        rotation,
+        max_subdivisions: None,
+        // Reweighting each domain on its own lowers each map's stretch but raised the composed
+        // map's folds on every different-shape pair measured (bench/NOTES.md).
+        stretch_iterations: 0,
+    };
+    let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
+    // The induced map read in the reference bases (basis 0 on each mesh), when the bases used
+    // are others or a matching was asked for.
+    let h1_reference = if want.is_some() || basis != [0, 0] {
+        let (fs, ft) = both(|| reference_frame(target, pairs[0].1), || reference_frame(source, pairs[0].0))?;
+        let (fs, ft) = (fs?, ft?);
+        Some(reference_h1((source, target), (&fs.1, &ft.1), (&r.source.basis, &r.target.basis), &r.h1)?)
+    } else {
+        None
+    };
+    if let (Some(w), Some(got)) = (&want, &h1_reference)
+        && got != w
+    {
+        return Err(Error::Numerical(format!(
+            "matching: the bases refined for the map induce {got:?} instead of {w:?}"
+        )));
+    }
+    clock.lap("basis_domain_map");
+    progress.check()?;
+    let f = finish_pair(
+        source,
+        target,
+        (&r.source_to_target, &r.target_to_source),
+        &pairs,
+        (&[], &[]),
+        &o.relax(),
+        progress,
+    )?;
+    clock.lap("smooth_metrics");
+    progress.check()?;
+    let g = r.source.basis.genus();
+    let len = |sd: &SideDomain| -> Vec<f64> {
+        let m = &sd.basis.refined.mesh;
+        sd.basis
+            .loops
+            .iter()
+            .map(|l| l.windows(2).map(|w| (m.position(w[1]) - m.position(w[0])).norm()).sum())
+            .collect()
+    };
+    let mut arts = artifacts::maps_and_meshes(&f.s2t, &f.t2s, &f.on_target, &f.on_source);
+    let mut meta = None;
+    let mut morph = None;
+    if o.meta_mesh {
+        progress.report(Stage::MetaMesh, 0.0);
+        let angle = std::f64::consts::TAU * r.side_shift as f64 / (4 * g) as f64;
+        let built = crate::homology::overlay::meta_mesh(&r.source, &r.target, angle);
+        let (stats, m) = meta_outputs(built, o.dihedral_threshold_deg, &mut arts);
+        meta = Some(stats);
+        morph = m;
+        clock.lap("meta_mesh");
+    }
+    let report_h = HomologyReport {
+        genus: g,
+        basis,
+        rotation,
+        side_shift: r.side_shift,
+        anchor_warp: r.warped,
+        h1: r.h1.clone(),
+        h1_reference,
+        base: [pairs[0].0.0, pairs[0].1.0],
+        subdivisions: [r.source.basis.subdivisions, r.target.basis.subdivisions],
+        loop_lengths: [len(&r.source), len(&r.target)],
+        meta_mesh: meta,
+    };
+    // The morph: the meta-mesh from source to target when there is one (every detail of both),
+    // else the source mesh to its image on the target.
+    arts.push(morph.unwrap_or_else(|| morph_glb(source, f.on_target.positions())));
+    arts.push(json_artifact("basis_source.json", &basis_json(&r.source))?);
+    arts.push(json_artifact("basis_target.json", &basis_json(&r.target))?);
+    arts.push(planar_obj("domain_source.obj", &r.source.domain.uv, &r.source.basis.disk.mesh)?);
+    arts.push(planar_obj("domain_target.obj", &r.target.domain.uv, &r.target.basis.disk.mesh)?);
+    clock.lap("artifacts");
+    let pair = PairReport::new("homology", pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
+    let mut report = HomologyMapReport { pair, homology: report_h };
+    report.pair.timings_ms = clock.finish();
+    arts.push(json_artifact("metrics.json", &report)?);
+    progress.report(Stage::Done, 1.0);
+    Ok((report, arts))
+}
+
+/// Loops as 3D polylines (a1, b1, …) on the basis's refinement, the intersection matrix and the
+/// boundary word.
+fn basis_json(sd: &SideDomain) -> serde_json::Value {
+    let b = &sd.basis;
+    json!({
+        "genus": b.genus(),
+        "base_vertex": b.base.0,
+        "loops": loops_json(b),
+        "intersection": b.intersection,
+        "word": b.word_text(),
+        "subdivisions": b.subdivisions,
+        "disk_euler_characteristic": crate::topology::euler_characteristic(&b.disk.mesh),
+    })
+}

@@ -1,0 +1,340 @@
+//! `voronoi` and `greedy`: layout -> flips and straightening -> refinement -> patch
+//! parameterization -> composition -> global map choice -> relaxation -> metrics -> artifacts,
+//! with progress, cancellation and per-stage timings.
+
+use super::common::relax::{Direction, finish_direction, measure_direction, relax_direction};
+use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
+use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
+use super::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
+use crate::crossparam::global::GlobalParamOptions;
+use crate::crossparam::{compose, parameterize_patches};
+use crate::domain::refine::refine;
+use crate::domain::tracer::Tracer;
+use crate::domain::{LayoutStats, greedy, patches_of, voronoi};
+use crate::error::{Error, InputError, Result};
+use crate::map::SurfaceMap;
+use crate::mesh::{Mesh, VertexId};
+use crate::progress::{Progress, Stage};
+use crate::topology;
+use serde::Serialize;
+
+/// What a `voronoi` or `greedy` job measured (`metrics.json`).
+#[derive(Debug, Clone, Serialize)]
+pub struct LayoutMapReport {
+    #[serde(flatten)]
+    pub pair: PairReport,
+    pub patches: usize,
+    pub layout: LayoutStats,
+    /// The global map onto the base domain, when it was tried.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub global: Option<GlobalReport>,
+}
+
+/// A layout conflict's message, naming the source anchors whose Voronoi cells are not disks
+/// (where a handle or tube is not separated by the anchors, the usual cause), if any.
+fn with_cell_hint(m: String, source: &Mesh, anchors: &[VertexId]) -> Error {
+    let bad = crate::domain::cuts::clusters(source, anchors).map(|c| c.non_disk(source)).unwrap_or_default();
+    let m = if bad.is_empty() {
+        m
+    } else {
+        format!(
+            "{m}; the source Voronoi cells of anchors {bad:?} (indices into the anchor list) are not disks \
+             (each holds a handle, or wraps a tube, that no anchor lies on): add anchors on it"
+        )
+    };
+    InputError::LayoutConflict(m).into()
+}
+
+/// A built layout: both meshes' traced paths and what building them took.
+struct Layout<'m> {
+    source: Tracer<'m>,
+    target: Tracer<'m>,
+    stats: LayoutStats,
+}
+
+/// Builds the common layout, rebuilding at denser edge nodes when it cannot be completed and
+/// falling back from `voronoi` to the greedy path choice (reported as `layout.fallback`)
+/// unless the options forbid it.
+fn build_layout<'m>(
+    method: Method,
+    (source, target): (&'m Mesh, &'m Mesh),
+    (sa, ta): (&[VertexId], &[VertexId]),
+    o: &MapOptions,
+    clock: &Clock,
+    progress: &mut dyn Progress,
+) -> Result<Layout<'m>> {
+    let chi = topology::euler_characteristic(source);
+    // Denser edge nodes leave more room between paths; a layout that cannot be completed at
+    // the requested density is rebuilt at higher ones before giving up.
+    let mut edge_nodes = o.layout.edge_nodes;
+    let mut attempt = 0;
+    let mut used = method;
+    loop {
+        let (st, tt) = both(|| Tracer::new(target, ta, &edge_nodes), || Tracer::new(source, sa, &edge_nodes))?;
+        let (mut st, mut tt) = (st?, tt?);
+        let built = match used {
+            Method::Voronoi => voronoi::source_layout(&mut st, chi, &o.layout, progress).and_then(|(cl, mut s)| {
+                let t = voronoi::target_layout_with_restarts(&st, &cl, &mut tt, &o.layout, 8, progress)?;
+                s.postponed = t.postponed;
+                s.failed_traces += t.failed_traces;
+                Ok(s)
+            }),
+            _ => greedy::greedy_layout(&mut st, &mut tt, chi, &o.layout, progress),
+        };
+        match built {
+            Ok(mut s) => {
+                s.rebuilds = attempt;
+                s.edge_nodes_min = edge_nodes.min_nodes;
+                s.fallback = (used != method).then(|| "greedy".to_string());
+                return Ok(Layout { source: st, target: tt, stats: s });
+            }
+            Err(Error::Input(InputError::LayoutConflict(m)))
+                if attempt >= o.layout.rebuilds && used == Method::Voronoi && o.layout.greedy_fallback =>
+            {
+                tracing::debug!("greedy fallback after ({:.0} ms): {m}", clock.elapsed_ms());
+                used = Method::Greedy;
+                edge_nodes = o.layout.edge_nodes;
+                attempt = 0;
+            }
+            Err(Error::Input(InputError::LayoutConflict(m))) if attempt < o.layout.rebuilds => {
+                tracing::debug!("rebuild after ({:.0} ms): {m}", clock.elapsed_ms());
+                // Rebuild schedule: without the denser anchor rings, then with them again and
+                // twice (minus one) the nodes per edge, then without, and so on.
+                if edge_nodes.ring_factor > 1 {
+                    edge_nodes.ring_factor = 1;
+                } else {
+                    edge_nodes.ring_factor = o.layout.edge_nodes.ring_factor;
+                    edge_nodes.min_nodes = edge_nodes.min_nodes * 2 - 1;
+                    edge_nodes.max_nodes = edge_nodes.max_nodes.max(edge_nodes.min_nodes);
+                }
+                attempt += 1;
+            }
+            Err(Error::Input(InputError::LayoutConflict(m))) => return Err(with_cell_hint(m, source, sa)),
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+/// The source and target of a job with their anchors, both ways.
+struct Pair<'a> {
+    source: &'a Mesh,
+    target: &'a Mesh,
+    pairs: &'a [(VertexId, VertexId)],
+    rev: &'a [(VertexId, VertexId)],
+    sa: &'a [VertexId],
+    ta: &'a [VertexId],
+}
+
+impl Pair<'_> {
+    /// Relaxes and measures the maps both ways, one direction on a side thread, so the
+    /// lighter direction's metrics overlap the heavier direction's smoothing.
+    fn finish(
+        &self,
+        (s2t, t2s): (SurfaceMap, SurfaceMap),
+        o: &RelaxOptions,
+        clock: &mut Clock,
+        progress: &mut dyn Progress,
+    ) -> Result<(Direction, Direction)> {
+        let mut side = progress.silent();
+        let (a, b) = both(
+            || finish_direction(self.target, self.source, t2s, self.ta, self.rev, o, &mut side, &mut || {}),
+            || {
+                finish_direction(self.source, self.target, s2t, self.sa, self.pairs, o, progress, &mut || {
+                    clock.lap("smooth")
+                })
+            },
+        )?;
+        Ok((a?, b?))
+    }
+
+    /// Relaxes both the per-patch maps `p` and the global maps `g` in each direction, keeps the
+    /// better pair (recorded in `report`) and measures it.
+    fn finish_contest(
+        &self,
+        p: (SurfaceMap, SurfaceMap),
+        g: (SurfaceMap, SurfaceMap),
+        o: &RelaxOptions,
+        report: &mut Option<GlobalReport>,
+        clock: &mut Clock,
+        progress: &mut dyn Progress,
+    ) -> Result<(Direction, Direction)> {
+        let relax_both = |from: &Mesh,
+                          to: &Mesh,
+                          p: SurfaceMap,
+                          g: SurfaceMap,
+                          fixed: &[VertexId],
+                          progress: &mut dyn Progress|
+         -> Result<_> {
+            let p = relax_direction(from, to, p, fixed, o, progress)?;
+            let g = relax_direction(from, to, g, fixed, o, progress)?;
+            let (qp, qg) = (relaxed_quality(from, to, &p.0)?, relaxed_quality(from, to, &g.0)?);
+            Ok((p, g, qp, qg))
+        };
+        let mut side = progress.silent();
+        let (x, y) = both(
+            || relax_both(self.target, self.source, p.1, g.1, self.ta, &mut side),
+            || relax_both(self.source, self.target, p.0, g.0, self.sa, progress),
+        )?;
+        let ((ps, gs, qps, qgs), (pt, gt, qpt, qgt)) = (x?, y?);
+        clock.lap("smooth");
+        let cmp = RelaxedComparison::new([qps, qpt], [qgs, qgt]);
+        let use_global = report.as_mut().map_or(cmp.prefers_global(), |r| r.record_relaxed(cmp));
+        let ((s2t, r1), (t2s, r2)) = if use_global { (gs, gt) } else { (ps, pt) };
+        let measure = |from: &Mesh,
+                       to: &Mesh,
+                       m: SurfaceMap,
+                       r,
+                       anchors: &[(VertexId, VertexId)],
+                       progress: &mut dyn Progress|
+         -> Result<Direction> {
+            let (e, met) = measure_direction(from, to, &m, anchors, o, progress)?;
+            Ok((m, r, e, met))
+        };
+        let (a, b) = both(
+            || measure(self.target, self.source, t2s, r2, self.rev, &mut side),
+            || measure(self.source, self.target, s2t, r1, self.pairs, progress),
+        )?;
+        Ok((a?, b?))
+    }
+}
+
+/// Runs a `voronoi` or `greedy` job.
+///
+/// # Errors
+/// Input errors for a spec that does not fit the meshes or anchors that admit no consistent
+/// layout; `Numerical` when a patch cannot be embedded; `Cancelled`.
+pub fn run(
+    method: Method,
+    spec: &LayoutSpec,
+    source: &Mesh,
+    target: &Mesh,
+    progress: &mut dyn Progress,
+) -> Result<(LayoutMapReport, Vec<Artifact>)> {
+    let go = GlobalParamOptions { enabled: spec.options.global.enabled, ..Default::default() };
+    run_with(method, spec, &go, source, target, progress)
+}
+
+/// [`run`] with every option of the global map (tests force it).
+fn run_with(
+    method: Method,
+    spec: &LayoutSpec,
+    go: &GlobalParamOptions,
+    source: &Mesh,
+    target: &Mesh,
+    progress: &mut dyn Progress,
+) -> Result<(LayoutMapReport, Vec<Artifact>)> {
+    let mut clock = Clock::start();
+    let pairs = spec.validate(method, source, target)?;
+    let o = &spec.options;
+    let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).collect();
+    let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).collect();
+    clock.lap("setup");
+    progress.report(Stage::Layout, 0.0);
+    let Layout { source: mut st, target: mut tt, mut stats } =
+        build_layout(method, (source, target), (&sa, &ta), o, &clock, progress)?;
+    clock.lap("layout");
+    stats.flipped = crate::domain::flip::flip_paths(&mut st, &mut tt, &o.layout.flip, progress)?.flipped;
+    clock.lap("flip");
+    let rounds = o.layout.straighten_rounds;
+    let mut side = progress.silent();
+    let (a, b) = both(
+        || crate::domain::straighten::straighten(&mut tt, rounds, &mut side),
+        || crate::domain::straighten::straighten(&mut st, rounds, progress),
+    )?;
+    stats.straightened = a? + b?;
+    clock.lap("straighten");
+    let patches = patches_of(&st);
+    stats.patches = patches.len();
+    progress.check()?;
+    // The target tracer moves to the side thread (its scratch is not `Sync`).
+    let (tt_ref, pr) = (&mut tt, &patches);
+    let (rs, rt) = both(move || refine(tt_ref, pr), || refine(&st, &patches))?;
+    let (rs, rt) = (rs?, rt?);
+    clock.lap("refine");
+    let mut side = progress.silent();
+    let (ps, pt) = both(
+        || parameterize_patches(&rt, &patches, &ta, &o.param, &mut side),
+        || parameterize_patches(&rs, &patches, &sa, &o.param, progress),
+    )?;
+    let (ps, pt) = (ps?, pt?);
+    clock.lap("parameterize");
+    let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
+    progress.report(Stage::Compose, 0.0);
+    let (s2t, t2s) =
+        both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
+    clock.lap("compose");
+    let inputs = GlobalInputs { patches: &patches, refined: (&rs, &rt), anchors: (&sa, &ta), params: (&ps, &pt) };
+    let (maps, contender, mut global) = choose_global(source, target, &inputs, (s2t, t2s), &pairs, &rev, go, progress)?;
+    clock.lap("global");
+    progress.check()?;
+    let pair = Pair { source, target, pairs: &pairs, rev: &rev, sa: &sa, ta: &ta };
+    let relax = o.relax();
+    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = match contender {
+        None => pair.finish(maps, &relax, &mut clock, progress)?,
+        Some(g) => pair.finish_contest(maps, g, &relax, &mut global, &mut clock, progress)?,
+    };
+    clock.lap("metrics");
+    progress.check()?;
+    let metrics = (m1, m2);
+    let pair = PairReport::new(method.name(), pairs.len(), (source, target), metrics, r1.merge(r2));
+    let mut report = LayoutMapReport { pair, patches: patches.len(), layout: stats, global };
+    let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, (&s2t, &t2s), &on_target, &on_source)?;
+    clock.lap("artifacts");
+    report.pair.timings_ms = clock.finish();
+    arts.push(json_artifact("metrics.json", &report)?);
+    progress.report(Stage::Done, 1.0);
+    Ok((report, arts))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+    use crate::progress::NoProgress;
+
+    /// Eight anchors around one meridian of a torus: every Voronoi cell is a band around the
+    /// long way of the torus, not a disk. With completion cut short, the conflict names them.
+    #[test]
+    fn a_layout_conflict_names_the_cells_that_are_not_disks() {
+        let m = shapes::torus(24, 8, 1.0, 0.3);
+        let anchors: Vec<[u64; 2]> = (0..8).map(|j| [j, j]).collect();
+        let mut options = MapOptions::default();
+        options.layout.max_attempts = 1;
+        options.layout.rebuilds = 0;
+        options.layout.greedy_fallback = false;
+        let spec = LayoutSpec { anchors, options };
+        let Err(Error::Input(e @ InputError::LayoutConflict(_))) = run(Method::Voronoi, &spec, &m, &m, &mut NoProgress)
+        else {
+            panic!("expected a layout conflict");
+        };
+        let msg = e.to_string();
+        assert!(msg.contains("anchors [0, 1, 2, 3, 4, 5, 6, 7]") && msg.contains("not disks"), "{msg}");
+    }
+
+    /// An icosphere onto itself with the icosahedron's twelve vertices as anchors: the layout
+    /// is the icosahedron, both global maps solve the same system with the same links (read
+    /// off two different tracings of the paths), so they agree and the composition is the
+    /// identity; the domain is a cone surface with cones of 300°, and no triangle folds in it.
+    #[test]
+    fn an_icosphere_onto_itself_is_the_identity_through_the_global_maps() {
+        let m = shapes::icosphere(3);
+        let mut options = MapOptions { metric_samples: 1000, ..Default::default() };
+        options.smoothing.iterations = 0;
+        let spec = LayoutSpec { anchors: (0..12).map(|i| [i, i]).collect(), options };
+        let go = GlobalParamOptions { force: true, ..Default::default() };
+        let (r, arts) = run_with(Method::Voronoi, &spec, &go, &m, &m, &mut NoProgress).unwrap();
+        let g = r.global.unwrap();
+        assert!(g.used);
+        assert_eq!(r.patches, 20);
+        assert_eq!(g.domain_folded, [0, 0], "no triangle folds in the domain");
+        assert_eq!(g.folded, [0, 0]);
+        assert!(g.residual.iter().all(|r| *r < 1e-12), "solver residuals {:?}", g.residual);
+        // Same system, same answer: the two maps' stretch agrees to rounding.
+        assert!((g.l2_stretch[0] - g.l2_stretch[1]).abs() < 1e-9, "{:?}", g.l2_stretch);
+        let obj = arts.iter().find(|a| a.name == "source_on_target.obj").unwrap();
+        let mapped = crate::io::read(&obj.bytes, &Default::default()).unwrap().mesh;
+        let worst = mapped.positions().iter().zip(m.positions()).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        assert!(worst < 1e-9, "identity up to rounding: {worst}");
+        assert_eq!(r.pair.source_to_target.flipped_faces, 0);
+    }
+}

@@ -111,8 +111,10 @@ pub fn clusters(mesh: &Mesh, anchors: &[VertexId]) -> Result<Clusters> {
         for (k, &e) in edges.iter().enumerate() {
             groups.entry(uf_find(&mut parent, k)).or_default().push(e);
         }
+        // Longest first; equal lengths by their first edge, so the order does not depend on the
+        // hash map's (per-process random) iteration order.
         let mut gs: Vec<Vec<EdgeId>> = groups.into_values().collect();
-        gs.sort_unstable_by_key(|g| std::cmp::Reverse(g.len()));
+        gs.sort_unstable_by_key(|g| (std::cmp::Reverse(g.len()), g[0]));
         for g in gs {
             let mut vertices: Vec<VertexId> = g.iter().flat_map(|&e| mesh.edge_vertices(e)).collect();
             vertices.sort_unstable();

@@ -20,6 +20,7 @@ pub mod linalg;
 pub mod map;
 pub mod mesh;
 pub mod metrics;
+pub mod optim;
 pub mod param;
 pub mod pipeline;
 pub mod planar;

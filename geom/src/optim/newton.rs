@@ -10,10 +10,14 @@
 //! enough (Armijo) **and** every triangle is positively oriented under Shewchuk's exact
 //! `orient2d`. A step that fails either test is never taken, so the map stays injective
 //! through every accepted iteration when it starts injective.
+//!
+//! Where the images live is a [`MapDomain`]: the plane ([`Plane`]), or a surface of charts
+//! (the common base domain of a layout) whose vertices each sit in a chart of their own, with
+//! a metric factor per triangle (the target surface's metric, frozen for one step).
 
 use super::block_system::BlockSystem;
 use super::max_step::first_inversion;
-use super::sym_dirichlet::RestTriangle;
+use super::sym_dirichlet::{IDENTITY, Mat2, RestTriangle};
 use crate::error::{Error, InputError, Result};
 use crate::param::Uv;
 use crate::progress::Progress;
@@ -46,6 +50,35 @@ pub struct InjectiveNewtonResult {
     pub backtracks: usize,
     /// Whether it stopped on the tolerance (not on the iteration limit or a zero step).
     pub converged: bool,
+}
+
+/// Where a map's images live and how they move.
+pub trait MapDomain {
+    /// Every vertex's image (each in a chart of its own).
+    type State: Clone;
+    /// The corners of triangle `tri` in one chart and, per corner, the linear map that carries
+    /// that vertex's own-chart displacement into it.
+    fn element(&self, s: &Self::State, tri: [u32; 3]) -> ([Uv; 3], [Mat2; 3]);
+    /// The metric factor of triangle `t` (its images are measured as `L J`), frozen for a step.
+    fn metric(&self, _s: &Self::State, _t: usize) -> Mat2 {
+        IDENTITY
+    }
+    /// The state with every vertex moved by `d` (in its own chart); `None` where a vertex
+    /// cannot go.
+    fn moved(&self, s: &Self::State, d: &[Uv]) -> Option<Self::State>;
+}
+
+/// Images in the plane, one chart.
+pub struct Plane;
+
+impl MapDomain for Plane {
+    type State = Vec<Uv>;
+    fn element(&self, s: &Vec<Uv>, tri: [u32; 3]) -> ([Uv; 3], [Mat2; 3]) {
+        (tri.map(|v| s[v as usize]), [IDENTITY; 3])
+    }
+    fn moved(&self, s: &Vec<Uv>, d: &[Uv]) -> Option<Vec<Uv>> {
+        Some(s.iter().zip(d).map(|(p, q)| [p[0] + q[0], p[1] + q[1]]).collect())
+    }
 }
 
 /// A triangulation with rest shapes and fixed vertices, ready to optimize images of.
@@ -86,83 +119,91 @@ impl InjectiveNewton {
         Ok(Self { triangles, rest, fixed: is_fixed, system })
     }
 
-    fn corners(&self, t: usize, x: &[Uv]) -> [Uv; 3] {
-        self.triangles[t].map(|v| x[v as usize])
+    /// Total energy with the domain's current metrics; `None` if any triangle is degenerate or
+    /// inverted.
+    pub fn energy<D: MapDomain>(&self, d: &D, s: &D::State) -> Option<f64> {
+        let metrics: Vec<Mat2> = (0..self.triangles.len()).map(|t| d.metric(s, t)).collect();
+        self.energy_with(d, s, &metrics)
     }
 
-    /// Total energy, `None` if any triangle is degenerate or inverted.
-    pub fn energy(&self, x: &[Uv]) -> Option<f64> {
-        (0..self.triangles.len()).map(|t| self.rest[t].energy(self.corners(t, x))).sum()
+    fn energy_with<D: MapDomain>(&self, d: &D, s: &D::State, metrics: &[Mat2]) -> Option<f64> {
+        (0..self.triangles.len()).map(|t| self.rest[t].energy_in(d.element(s, self.triangles[t]).0, &metrics[t])).sum()
     }
 
-    /// Whether every triangle is positively oriented under the exact predicate.
-    pub fn is_injective(&self, x: &[Uv]) -> bool {
+    /// Whether every triangle is positively oriented in its chart under the exact predicate.
+    pub fn is_injective<D: MapDomain>(&self, d: &D, s: &D::State) -> bool {
         let c = |p: Uv| robust::Coord { x: p[0], y: p[1] };
-        (0..self.triangles.len()).all(|t| {
-            let [a, b, d] = self.corners(t, x);
-            robust::orient2d(c(a), c(b), c(d)) > 0.0
+        self.triangles.iter().all(|&tri| {
+            let [a, b, e] = d.element(s, tri).0;
+            robust::orient2d(c(a), c(b), c(e)) > 0.0
         })
     }
 
-    /// Minimizes the energy from the injective start `x`, in place; every accepted step keeps
+    /// Minimizes the energy from the injective start `s`, in place; every accepted step keeps
     /// every triangle positively oriented. Checks for cancellation every iteration.
     ///
     /// # Errors
-    /// `Invalid` when `x` does not start injective; `Numerical` when a Newton system cannot
+    /// `Invalid` when `s` does not start injective; `Numerical` when a Newton system cannot
     /// be solved; `Cancelled`.
-    pub fn minimize(
+    pub fn minimize<D: MapDomain>(
         &self,
-        x: &mut [Uv],
+        d: &D,
+        s: &mut D::State,
         opts: &InjectiveNewtonOptions,
         progress: &dyn Progress,
     ) -> Result<InjectiveNewtonResult> {
-        if x.len() != self.fixed.len() {
-            return Err(InputError::Invalid("one position per vertex".into()).into());
-        }
-        let mut energy = match self.energy(x) {
-            Some(e) if self.is_injective(x) => e,
+        let start = match self.energy(d, s) {
+            Some(e) if self.is_injective(d, s) => e,
             _ => return Err(InputError::Invalid("the start map is not injective".into()).into()),
         };
         let mut r = InjectiveNewtonResult {
             iterations: 0,
-            energy_before: energy,
-            energy_after: energy,
+            energy_before: start,
+            energy_after: start,
             backtracks: 0,
             converged: false,
         };
         for _ in 0..opts.max_iterations {
             progress.check()?;
-            let dir = self.direction(x)?;
-            let Some((next, e, backtracks)) = self.line_search(x, &dir, energy, opts) else {
+            // The metrics are frozen for the step: the energy it lowers is this one.
+            let metrics: Vec<Mat2> = (0..self.triangles.len()).map(|t| d.metric(s, t)).collect();
+            let energy = self
+                .energy_with(d, s, &metrics)
+                .ok_or_else(|| Error::Internal("an inverted triangle inside the optimization".into()))?;
+            let dir = self.direction(d, s, &metrics)?;
+            let Some((next, e, backtracks)) = self.line_search(d, s, &dir, &metrics, energy, opts) else {
                 r.converged = true;
                 break;
             };
             r.iterations += 1;
             r.backtracks += backtracks;
-            x.copy_from_slice(&next);
-            let gain = (energy - e) / energy.abs().max(f64::MIN_POSITIVE);
-            energy = e;
-            if gain < opts.tolerance {
+            *s = next;
+            r.energy_after = e;
+            if (energy - e) / energy.abs().max(f64::MIN_POSITIVE) < opts.tolerance {
                 r.converged = true;
                 break;
             }
         }
-        r.energy_after = energy;
+        if let Some(e) = self.energy(d, s) {
+            r.energy_after = e;
+        }
         Ok(r)
     }
 
-    /// The Newton direction per vertex (zero on fixed vertices), with the gradient dotted into it.
-    fn direction(&self, x: &[Uv]) -> Result<(Vec<Uv>, f64)> {
+    /// The Newton direction per vertex in its own chart (zero on fixed vertices), with the
+    /// gradient dotted into it.
+    fn direction<D: MapDomain>(&self, d: &D, s: &D::State, metrics: &[Mat2]) -> Result<(Vec<Uv>, f64)> {
         let n = self.system.len();
         let mut grad = vec![0.0; n];
         let mut values = self.system.zero_values();
-        for t in 0..self.triangles.len() {
+        for (t, &tri) in self.triangles.iter().enumerate() {
+            let (x, m) = d.element(s, tri);
             let (_, g, h) = self.rest[t]
-                .derivatives(self.corners(t, x))
+                .derivatives_in(x, &metrics[t], &m)
                 .ok_or_else(|| Error::Internal("an inverted triangle inside the optimization".into()))?;
-            for (k, &d) in self.system.dofs(t).iter().enumerate() {
-                if d != usize::MAX {
-                    grad[d] += g[k];
+            for (k, &i) in self.system.dofs(t).iter().enumerate() {
+                if i != usize::MAX {
+                    grad[i] += g[k];
                 }
             }
             self.system.add_block(&mut values, t, &h);
@@ -173,45 +214,63 @@ impl InjectiveNewton {
         let mut shift = 1e-10 * scale;
         let step = loop {
             match self.system.solve(&values, shift, &rhs) {
-                Ok(s) => break s,
+                Ok(x) => break x,
                 Err(_) if shift < 1e-2 * scale => shift *= 100.0,
                 Err(e) => return Err(e),
             }
         };
-        let slope: f64 = step.iter().zip(&grad).map(|(s, g)| s * g).sum();
-        let mut dir = vec![[0.0; 2]; x.len()];
+        let slope: f64 = step.iter().zip(&grad).map(|(a, g)| a * g).sum();
+        let mut dir = vec![[0.0; 2]; self.fixed.len()];
         let mut k = 0;
-        for (v, d) in dir.iter_mut().enumerate() {
+        for (v, out) in dir.iter_mut().enumerate() {
             if !self.fixed[v] {
-                *d = [step[k], step[k + 1]];
+                *out = [step[k], step[k + 1]];
                 k += 2;
             }
         }
         Ok((dir, slope))
     }
 
-    /// The accepted positions, their energy and the refused trials; `None` when no step along
-    /// the direction lowers the energy.
-    fn line_search(
+    /// The first time any triangle inverts along `dir` (each corner's move carried into the
+    /// triangle's chart).
+    fn first_inversion<D: MapDomain>(&self, d: &D, s: &D::State, dir: &[Uv]) -> f64 {
+        self.triangles
+            .iter()
+            .map(|&tri| {
+                let (x, m) = d.element(s, tri);
+                let mut k = 0;
+                let moves = tri.map(|v| {
+                    let (q, mi) = (dir[v as usize], m[k]);
+                    k += 1;
+                    [mi[0][0] * q[0] + mi[0][1] * q[1], mi[1][0] * q[0] + mi[1][1] * q[1]]
+                });
+                first_inversion(x, moves)
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The accepted state, its energy and the refused trials; `None` when no step along the
+    /// direction lowers the energy.
+    fn line_search<D: MapDomain>(
         &self,
-        x: &[Uv],
+        d: &D,
+        s: &D::State,
         (dir, slope): &(Vec<Uv>, f64),
+        metrics: &[Mat2],
         energy: f64,
         opts: &InjectiveNewtonOptions,
-    ) -> Option<(Vec<Uv>, f64, usize)> {
+    ) -> Option<(D::State, f64, usize)> {
         if *slope >= 0.0 {
             return None;
         }
-        let max = (0..self.triangles.len())
-            .map(|t| first_inversion(self.corners(t, x), self.triangles[t].map(|v| dir[v as usize])))
-            .fold(f64::INFINITY, f64::min);
-        let mut t = (opts.step_fraction * max).min(1.0);
+        let mut t = (opts.step_fraction * self.first_inversion(d, s, dir)).min(1.0);
         let mut backtracks = 0;
         while t > 1e-12 {
-            let trial: Vec<Uv> = x.iter().zip(dir).map(|(p, d)| [p[0] + t * d[0], p[1] + t * d[1]]).collect();
-            if let Some(e) = self.energy(&trial)
+            let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
+            if let Some(trial) = d.moved(s, &step)
+                && let Some(e) = self.energy_with(d, &trial, metrics)
                 && e <= energy + 1e-4 * t * slope
-                && self.is_injective(&trial)
+                && self.is_injective(d, &trial)
             {
                 return Some((trial, e, backtracks));
             }
@@ -244,17 +303,17 @@ mod tests {
         let pi = std::f64::consts::PI;
         let mut x: Vec<Uv> =
             rest_pos.iter().map(|p| [p[0] + 0.3 * (pi * p[0]).sin() * (pi * p[1]).sin(), p[1]]).collect();
-        assert!(opt.is_injective(&x));
+        assert!(opt.is_injective(&Plane, &x));
         let opts = InjectiveNewtonOptions { max_iterations: 1, ..Default::default() };
-        let mut last = opt.energy(&x).unwrap();
+        let mut last = opt.energy(&Plane, &x).unwrap();
         let start = last;
         for _ in 0..60 {
-            let r = opt.minimize(&mut x, &opts, &NoProgress).unwrap();
-            assert!(opt.is_injective(&x), "an accepted step inverted a triangle");
+            let r = opt.minimize(&Plane, &mut x, &opts, &NoProgress).unwrap();
+            assert!(opt.is_injective(&Plane, &x), "an accepted step inverted a triangle");
             assert!(r.energy_after <= last, "{} > {last}", r.energy_after);
             last = r.energy_after;
         }
-        let ideal = 4.0 * (0..opt.triangles.len()).map(|t| opt.rest[t].area()).sum::<f64>();
+        let ideal = 4.0 * opt.rest.iter().map(|r| r.area()).sum::<f64>();
         assert!(last < start && (last - ideal) / ideal < 1e-3, "start {start}, end {last}, ideal {ideal}");
     }
 
@@ -277,25 +336,28 @@ mod tests {
         let dir: Vec<Uv> = (0..5).map(|v| if v == 4 { [0.0, -10.0] } else { [0.0, 0.0] }).collect();
         let along = |t: f64| {
             let y: Vec<Uv> = x.iter().zip(&dir).map(|(p, d)| [p[0] + t * d[0], p[1] + t * d[1]]).collect();
-            opt.energy(&y)
+            opt.energy(&Plane, &y)
         };
         let h = 1e-7;
         let slope = (along(h).unwrap() - along(-h).unwrap()) / (2.0 * h);
         assert!(slope < 0.0);
-        let max = (0..4)
-            .map(|t| first_inversion(opt.corners(t, &x), opt.triangles[t].map(|v| dir[v as usize])))
-            .fold(f64::INFINITY, f64::min);
+        let max = opt.first_inversion(&Plane, &x, &dir);
         assert!((max - 0.09).abs() < 1e-12, "first inversion at {max}");
         assert!(along(1.0).is_none(), "the full step inverts");
-        let e0 = opt.energy(&x).unwrap();
-        let (y, e, _) = opt.line_search(&x, &(dir, slope), e0, &InjectiveNewtonOptions::default()).unwrap();
-        assert!(opt.is_injective(&y) && e < e0);
+        let e0 = opt.energy(&Plane, &x).unwrap();
+        let metrics = [IDENTITY; 4];
+        let (y, e, _) =
+            opt.line_search(&Plane, &x, &(dir, slope), &metrics, e0, &InjectiveNewtonOptions::default()).unwrap();
+        assert!(opt.is_injective(&Plane, &y) && e < e0);
         assert!(y[4][1] > 0.0 && y[4][1] < 0.9, "{:?}", y[4]);
-        let r = opt.minimize(&mut x, &InjectiveNewtonOptions::default(), &NoProgress).unwrap();
-        assert!(opt.is_injective(&x) && r.converged);
+        let r = opt.minimize(&Plane, &mut x, &InjectiveNewtonOptions::default(), &NoProgress).unwrap();
+        assert!(opt.is_injective(&Plane, &x) && r.converged);
         assert!((x[4][0] - 0.5).abs() < 1e-6 && (x[4][1] - 0.5).abs() < 1e-6, "{:?}", x[4]);
         // An inverted start is refused.
         x[4] = [0.5, -0.1];
-        assert_eq!(opt.minimize(&mut x, &Default::default(), &NoProgress).unwrap_err().code(), "invalid_argument");
+        assert_eq!(
+            opt.minimize(&Plane, &mut x, &Default::default(), &NoProgress).unwrap_err().code(),
+            "invalid_argument"
+        );
     }
 }

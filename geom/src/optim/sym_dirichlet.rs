@@ -6,6 +6,11 @@
 //! In 2D `|J⁻¹|² = |J|² / det(J)²`, so the energy is `A s (1 + 1/D²)` with `s = |J|²` and
 //! `D = det J`; it grows without bound as a triangle degenerates, which is what keeps an
 //! optimization that starts injective away from inversions (with [`super::max_step`]).
+//!
+//! Two generalizations serve maps between surfaces through a common domain: a *metric factor*
+//! `L` (the image's metric `LᵀL`, e.g. the target surface's pulled back into the domain, frozen
+//! for a step) measures `L J` instead of `J`; and each corner's unknowns may live in a chart of
+//! their own, carried into the triangle's chart by a linear map `M_i` (a rigid transition).
 
 use crate::param::Uv;
 use nalgebra::{Matrix4, SMatrix, SymmetricEigen, Vector4};
@@ -19,6 +24,12 @@ pub struct RestTriangle {
 
 /// Energy, gradient in the six image coordinates (`x0, y0, x1, y1, x2, y2`) and projected Hessian.
 pub type Derivatives = (f64, [f64; 6], [[f64; 6]; 6]);
+
+/// A 2×2 matrix, row-major.
+pub type Mat2 = [[f64; 2]; 2];
+
+/// The identity.
+pub const IDENTITY: Mat2 = [[1.0, 0.0], [0.0, 1.0]];
 
 impl RestTriangle {
     /// From rest positions in the plane (counter-clockwise); `None` for a degenerate triangle.
@@ -62,15 +73,47 @@ impl RestTriangle {
         b
     }
 
-    fn jacobian(&self, x: [Uv; 3]) -> Vector4<f64> {
+    /// `vec(L J) = B' d` for corner displacements `d` in their own charts (`dx_i = M_i d_i`).
+    fn b_general(&self, l: &Mat2, m: &[Mat2; 3]) -> SMatrix<f64, 4, 6> {
+        let b = self.b();
+        let mut lb = SMatrix::<f64, 4, 6>::zeros();
+        for r in 0..2 {
+            for c in 0..2 {
+                for k in 0..2 {
+                    for j in 0..6 {
+                        lb[(2 * r + c, j)] += l[r][k] * b[(2 * k + c, j)];
+                    }
+                }
+            }
+        }
+        let mut blocks = SMatrix::<f64, 6, 6>::zeros();
+        for (i, mi) in m.iter().enumerate() {
+            for r in 0..2 {
+                for c in 0..2 {
+                    blocks[(2 * i + r, 2 * i + c)] = mi[r][c];
+                }
+            }
+        }
+        lb * blocks
+    }
+
+    /// `vec(L J)` at image corners `x`.
+    fn jacobian_in(&self, x: [Uv; 3], l: &Mat2) -> Vector4<f64> {
         let ds = [[x[1][0] - x[0][0], x[2][0] - x[0][0]], [x[1][1] - x[0][1], x[2][1] - x[0][1]]];
         let j = |r: usize, c: usize| ds[r][0] * self.inv[0][c] + ds[r][1] * self.inv[1][c];
-        Vector4::new(j(0, 0), j(0, 1), j(1, 0), j(1, 1))
+        let lj = |r: usize, c: usize| l[r][0] * j(0, c) + l[r][1] * j(1, c);
+        Vector4::new(lj(0, 0), lj(0, 1), lj(1, 0), lj(1, 1))
     }
 
     /// The energy at image positions `x`; `None` when the image is degenerate or inverted.
     pub fn energy(&self, x: [Uv; 3]) -> Option<f64> {
-        let v = self.jacobian(x);
+        self.energy_in(x, &IDENTITY)
+    }
+
+    /// The energy of `L J` at image corners `x` (all in one chart); `None` when degenerate or
+    /// inverted (a metric factor must have a positive determinant).
+    pub fn energy_in(&self, x: [Uv; 3], l: &Mat2) -> Option<f64> {
+        let v = self.jacobian_in(x, l);
         let d = v[0] * v[3] - v[1] * v[2];
         if d.is_nan() || d <= 0.0 {
             return None;
@@ -81,10 +124,16 @@ impl RestTriangle {
 
     /// Energy, gradient and PSD-projected Hessian at `x`; `None` when inverted or degenerate.
     pub fn derivatives(&self, x: [Uv; 3]) -> Option<Derivatives> {
-        let v = self.jacobian(x);
+        self.derivatives_in(x, &IDENTITY, &[IDENTITY; 3])
+    }
+
+    /// [`RestTriangle::derivatives`] of `L J`, with respect to each corner's displacement in
+    /// its own chart (`m[i]` carries it into the chart of `x`).
+    pub fn derivatives_in(&self, x: [Uv; 3], l: &Mat2, m: &[Mat2; 3]) -> Option<Derivatives> {
+        let v = self.jacobian_in(x, l);
         let (g, h) = jacobian_derivatives(&v)?;
         let h = project_psd(h);
-        let b = self.b();
+        let b = self.b_general(l, m);
         let gx = b.transpose() * g * self.area;
         let hx = b.transpose() * h * b * self.area;
         let d = v[0] * v[3] - v[1] * v[2];
@@ -165,7 +214,7 @@ mod tests {
         let flat = |x: [Uv; 3]| [x[0][0], x[0][1], x[1][0], x[1][1], x[2][0], x[2][1]];
         let unflat = |f: [f64; 6]| [[f[0], f[1]], [f[2], f[3]], [f[4], f[5]]];
         let (_, g, _) = r.derivatives(x).unwrap();
-        let (_, hj) = jacobian_derivatives(&r.jacobian(x)).unwrap();
+        let (_, hj) = jacobian_derivatives(&r.jacobian_in(x, &IDENTITY)).unwrap();
         let hx = r.b().transpose() * hj * r.b() * r.area();
         let h = 1e-6;
         for i in 0..6 {
@@ -181,6 +230,35 @@ mod tests {
                 let fd = (gp[j] - gm[j]) / (2.0 * h);
                 assert!((fd - hx[(j, i)]).abs() < 1e-5 * (1.0 + fd.abs()), "hessian {j},{i}: {fd} vs {}", hx[(j, i)]);
             }
+        }
+    }
+
+    /// With a metric factor and rotated corner charts, the derivatives are those of the energy
+    /// of `L J` as a function of the corners' own-chart displacements.
+    #[test]
+    fn metric_and_chart_derivatives_match_finite_differences() {
+        let r = rest();
+        let x = [[0.1, -0.05], [1.3, 0.2], [0.2, 1.1]];
+        let l = [[1.3, 0.2], [0.0, 0.7]];
+        let rot = |a: f64| [[a.cos(), -a.sin()], [a.sin(), a.cos()]];
+        let m = [IDENTITY, rot(0.4), rot(-1.1)];
+        let moved = |d: [f64; 6]| {
+            let mut y = x;
+            for i in 0..3 {
+                y[i][0] += m[i][0][0] * d[2 * i] + m[i][0][1] * d[2 * i + 1];
+                y[i][1] += m[i][1][0] * d[2 * i] + m[i][1][1] * d[2 * i + 1];
+            }
+            r.energy_in(y, &l).unwrap()
+        };
+        let (e, g, _) = r.derivatives_in(x, &l, &m).unwrap();
+        assert!((e - moved([0.0; 6])).abs() < 1e-12);
+        let h = 1e-6;
+        for i in 0..6 {
+            let (mut p, mut q) = ([0.0; 6], [0.0; 6]);
+            p[i] = h;
+            q[i] = -h;
+            let fd = (moved(p) - moved(q)) / (2.0 * h);
+            assert!((fd - g[i]).abs() < 1e-6 * (1.0 + g[i].abs()), "gradient {i}: {fd} vs {}", g[i]);
         }
     }
 

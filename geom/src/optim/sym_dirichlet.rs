@@ -122,6 +122,25 @@ impl RestTriangle {
         e.is_finite().then_some(e)
     }
 
+    /// The untangling energy of Garanzha et al. 2021: `det J` replaced by the always positive
+    /// `χ(D, ε) = (D + √(ε² + D²)) / 2`, finite on inverted triangles and equal to the energy
+    /// above as `ε → 0` where `D > 0`.
+    pub fn energy_eps(&self, x: [Uv; 3], l: &Mat2, eps: f64) -> Option<f64> {
+        let v = self.jacobian_in(x, l);
+        let d = v[0] * v[3] - v[1] * v[2];
+        let chi = 0.5 * (d + (eps * eps + d * d).sqrt());
+        let e = self.area * v.norm_squared() * (1.0 + 1.0 / (chi * chi));
+        e.is_finite().then_some(e)
+    }
+
+    /// [`RestTriangle::derivatives_in`] of [`RestTriangle::energy_eps`].
+    pub fn derivatives_eps(&self, x: [Uv; 3], l: &Mat2, m: &[Mat2; 3], eps: f64) -> Option<Derivatives> {
+        let v = self.jacobian_in(x, l);
+        let (g, h) = jacobian_derivatives_eps(&v, eps)?;
+        let e = self.energy_eps(x, l, eps)?;
+        Some(self.carried_to_corners(e, g, project_psd(h), l, m))
+    }
+
     /// Energy, gradient and PSD-projected Hessian at `x`; `None` when inverted or degenerate.
     pub fn derivatives(&self, x: [Uv; 3]) -> Option<Derivatives> {
         self.derivatives_in(x, &IDENTITY, &[IDENTITY; 3])
@@ -132,12 +151,15 @@ impl RestTriangle {
     pub fn derivatives_in(&self, x: [Uv; 3], l: &Mat2, m: &[Mat2; 3]) -> Option<Derivatives> {
         let v = self.jacobian_in(x, l);
         let (g, h) = jacobian_derivatives(&v)?;
-        let h = project_psd(h);
+        let e = self.energy_in(x, l)?;
+        Some(self.carried_to_corners(e, g, project_psd(h), l, m))
+    }
+
+    /// Energy and derivatives in `vec(L J)` carried to the corners' displacements.
+    fn carried_to_corners(&self, e: f64, g: Vector4<f64>, h: Matrix4<f64>, l: &Mat2, m: &[Mat2; 3]) -> Derivatives {
         let b = self.b_general(l, m);
         let gx = b.transpose() * g * self.area;
         let hx = b.transpose() * h * b * self.area;
-        let d = v[0] * v[3] - v[1] * v[2];
-        let e = self.area * v.norm_squared() * (1.0 + 1.0 / (d * d));
         let mut grad = [0.0; 6];
         let mut hess = [[0.0; 6]; 6];
         for i in 0..6 {
@@ -146,7 +168,7 @@ impl RestTriangle {
                 hess[i][j] = hx[(i, j)];
             }
         }
-        Some((e, grad, hess))
+        (e, grad, hess)
     }
 }
 
@@ -170,6 +192,34 @@ fn jacobian_derivatives(v: &Vector4<f64>) -> Option<(Vector4<f64>, Matrix4<f64>)
     k[(2, 1)] = -1.0;
     let hess = Matrix4::identity() * (2.0 * g) - (v * dd.transpose() + dd * v.transpose()) * (4.0 * i3)
         + (dd * dd.transpose() * (6.0 * i4) - k * (2.0 * i3)) * s;
+    (grad.iter().chain(hess.iter()).all(|x| x.is_finite())).then_some((grad, hess))
+}
+
+/// Gradient and Hessian of `|J|² (1 + 1/χ(det J, ε)²)` in `vec(J)`.
+fn jacobian_derivatives_eps(v: &Vector4<f64>, eps: f64) -> Option<(Vector4<f64>, Matrix4<f64>)> {
+    let (a, b, c, d) = (v[0], v[1], v[2], v[3]);
+    let det = a * d - b * c;
+    let r = (eps * eps + det * det).sqrt();
+    if r <= 0.0 {
+        return None;
+    }
+    let chi = 0.5 * (det + r);
+    let (c1, c2) = (0.5 * (1.0 + det / r), 0.5 * eps * eps / (r * r * r));
+    // h(D) = 1 + χ⁻², and its first two derivatives in D.
+    let h = 1.0 + chi.powi(-2);
+    let h1 = -2.0 * chi.powi(-3) * c1;
+    let h2 = 6.0 * chi.powi(-4) * c1 * c1 - 2.0 * chi.powi(-3) * c2;
+    let s = v.norm_squared();
+    let dd = Vector4::new(d, -c, -b, a);
+    let grad = v * (2.0 * h) + dd * (s * h1);
+    let mut k = Matrix4::zeros();
+    k[(0, 3)] = 1.0;
+    k[(3, 0)] = 1.0;
+    k[(1, 2)] = -1.0;
+    k[(2, 1)] = -1.0;
+    let hess = Matrix4::identity() * (2.0 * h)
+        + (v * dd.transpose() + dd * v.transpose()) * (2.0 * h1)
+        + (dd * dd.transpose() * h2 + k * h1) * s;
     (grad.iter().chain(hess.iter()).all(|x| x.is_finite())).then_some((grad, hess))
 }
 
@@ -260,6 +310,26 @@ mod tests {
             let fd = (moved(p) - moved(q)) / (2.0 * h);
             assert!((fd - g[i]).abs() < 1e-6 * (1.0 + g[i].abs()), "gradient {i}: {fd} vs {}", g[i]);
         }
+    }
+
+    /// The untangling energy's gradient against central differences, on an inverted image.
+    #[test]
+    fn untangling_derivatives_match_finite_differences() {
+        let r = rest();
+        let x = [[0.0, 0.0], [0.3, 0.8], [1.0, 0.1]];
+        let eps = 0.3;
+        let (_, g, _) = r.derivatives_eps(x, &IDENTITY, &[IDENTITY; 3], eps).unwrap();
+        let h = 1e-6;
+        for i in 0..6 {
+            let (mut p, mut q) = (x, x);
+            p[i / 2][i % 2] += h;
+            q[i / 2][i % 2] -= h;
+            let fd = (r.energy_eps(p, &IDENTITY, eps).unwrap() - r.energy_eps(q, &IDENTITY, eps).unwrap()) / (2.0 * h);
+            assert!((fd - g[i]).abs() < 1e-5 * (1.0 + g[i].abs()), "gradient {i}: {fd} vs {}", g[i]);
+        }
+        // Far from zero the two energies agree.
+        let y = [[0.1, -0.05], [1.3, 0.2], [0.2, 1.1]];
+        assert!((r.energy_eps(y, &IDENTITY, 1e-9).unwrap() - r.energy(y).unwrap()).abs() < 1e-9);
     }
 
     #[test]

@@ -31,6 +31,15 @@ impl PatchLocator {
         let (t, b) = self.grid.locate(&self.uv, &self.tris, x);
         Some((self.face[t as usize], b))
     }
+
+    /// [`PatchLocator::locate`] with the face's corners in this chart.
+    pub fn locate_triangle(&self, x: Uv) -> Option<(FaceId, [Uv; 3])> {
+        if self.tris.is_empty() {
+            return None;
+        }
+        let (t, _) = self.grid.locate(&self.uv, &self.tris, x);
+        Some((self.face[t as usize], self.tris[t as usize].map(|v| self.uv[v as usize])))
+    }
 }
 
 /// Builds every patch's locator for `mesh` mapped by `st`. Triangles folded in a chart are

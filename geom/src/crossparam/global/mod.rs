@@ -14,6 +14,7 @@
 //! [`compose`] carries one mesh to the other through both maps ([`locate`]).
 
 pub mod charts;
+pub mod domain_map;
 pub mod links;
 pub mod locate;
 pub mod solve;
@@ -103,6 +104,48 @@ pub fn global_param(
     opts: &GlobalParamOptions,
     progress: &mut dyn crate::progress::Progress,
 ) -> Result<GlobalParam> {
+    let seed = seed(mesh, patches, anchors, init, refined, lengths)?;
+    let Seed { charts, mut state, fixed, rows } = seed;
+    let st = &mut state;
+    let debug = tracing::enabled!(tracing::Level::DEBUG);
+    let mut system = solve::System::new(&fixed);
+    let residual = relax(&charts, &mut system, st, &fixed, &rows, opts.max_solves)?;
+    progress.check()?;
+    let l2 = vertex_stretch(mesh, st, &rows, &fixed);
+    if debug {
+        tracing::debug!(
+            "global: harmonic map: folds {} l2 {l2} residual {residual:.2e}",
+            flipped(mesh, st, &rows, &fixed)
+        );
+    }
+    let flipped = flipped(mesh, st, &rows, &fixed);
+    let locators = locate::locators(mesh, &charts, st, &rows, &fixed);
+    Ok(GlobalParam { charts, state, locators, flipped, l2, residual })
+}
+
+/// A mesh placed on the base domain before any solve: the charts, every vertex's patch and
+/// chart position (anchors at their corners), the links between neighbours' charts, the
+/// anchors as fixed vertices and the mesh's mean-value rows.
+pub struct Seed {
+    pub charts: Charts,
+    pub state: State,
+    pub fixed: Vec<bool>,
+    pub rows: Rows,
+}
+
+/// [`Seed`] of `mesh` from `init` (per vertex: patch and position in [`super::TRIANGLE`]); as
+/// [`global_param`] before it solves.
+///
+/// # Errors
+/// As [`global_param`].
+pub fn seed(
+    mesh: &Mesh,
+    patches: &[Patch],
+    anchors: &[VertexId],
+    init: &[(u32, Uv)],
+    refined: Option<&crate::domain::refine::Refined>,
+    lengths: Option<&[f64]>,
+) -> Result<Seed> {
     let charts = Charts::new(patches, anchors.len(), lengths)?;
     let n = mesh.n_vertices();
     if init.len() != n || init.iter().any(|(p, _)| *p as usize >= patches.len()) {
@@ -130,20 +173,7 @@ pub fn global_param(
         st.link = links::from_refinement(mesh, r, patches, &charts, &st, &rows);
     }
     st.fill_links(&charts, &rows);
-    let debug = tracing::enabled!(tracing::Level::DEBUG);
-    let mut system = solve::System::new(&fixed);
-    let residual = relax(&charts, &mut system, &mut st, &fixed, &rows, opts.max_solves)?;
-    progress.check()?;
-    let l2 = vertex_stretch(mesh, &st, &rows, &fixed);
-    if debug {
-        tracing::debug!(
-            "global: harmonic map: folds {} l2 {l2} residual {residual:.2e}",
-            flipped(mesh, &st, &rows, &fixed)
-        );
-    }
-    let flipped = flipped(mesh, &st, &rows, &fixed);
-    let locators = locate::locators(mesh, &charts, &st, &rows, &fixed);
-    Ok(GlobalParam { charts, state: st, locators, flipped, l2, residual })
+    Ok(Seed { charts, state: st, fixed, rows })
 }
 
 /// Solves, moves vertices into the patches they entered and carries their links along, until
@@ -220,7 +250,7 @@ fn vertex_stretch(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool]) -> f64 {
     (tn * uv_area / td.max(f64::MIN_POSITIVE) / td.max(f64::MIN_POSITIVE)).sqrt()
 }
 
-fn flipped(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool]) -> usize {
+pub(crate) fn flipped(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool]) -> usize {
     (0..mesh.n_faces())
         .filter(|&f| match face_uv(mesh, st, rows, fixed, FaceId::from_idx(f)) {
             Some(q) => (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]) <= 0.0,

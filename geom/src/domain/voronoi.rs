@@ -18,7 +18,7 @@ use super::complete::complete;
 use super::cuts::{Clusters, clusters};
 use super::tracer::{Half, TraceRequest, Tracer};
 use super::walks::walks;
-use super::{LayoutOptions, LayoutStats, Sector};
+use super::{LayoutOptions, LayoutPath, LayoutStats, Sector};
 use crate::error::{InputError, Result};
 use crate::geodesic::NodeId;
 use crate::mesh::{Mesh, VertexId};
@@ -198,30 +198,8 @@ pub fn target_layout(
     let anchors = tgt.anchors().to_vec();
     let cl = clusters(tgt.mesh(), &anchors)?;
     let np = src.paths().len();
-    let mut linkages = std::collections::HashMap::<(u32, u32), usize>::new();
-    for p in src.paths() {
-        *linkages.entry((p.a.min(p.b), p.a.max(p.b))).or_default() += 1;
-    }
-    let lk = |s: usize| linkages[&(src.paths()[s].a.min(src.paths()[s].b), src.paths()[s].a.max(src.paths()[s].b))];
-    // Groups: 0 = single linkage, one target cut; 1 = single linkage otherwise; 2 = multiple.
-    let group = |s: usize| {
-        let p = &src.paths()[s];
-        if lk(s) > 1 {
-            2
-        } else if cl.between(p.a, p.b).count() == 1 {
-            0
-        } else {
-            1
-        }
-    };
-    let mut queue: Vec<usize> = (0..np).collect();
-    let rank = |s: usize| priority.iter().position(|&p| p == s).unwrap_or(usize::MAX);
-    queue.sort_by(|&x, &y| {
-        // Within a group, shortest source paths first.
-        (rank(x), group(x), src.paths()[x].length)
-            .partial_cmp(&(rank(y), group(y), src.paths()[y].length))
-            .unwrap_or(std::cmp::Ordering::Equal)
-    });
+    let order = PathOrder::new(src, &cl, priority);
+    let mut queue = order.queue(src);
     let mut tid: Vec<Option<u32>> = vec![None; np];
     let mut sid: Vec<u32> = Vec::with_capacity(np);
     let mut stats = LayoutStats { cuts: cl.cuts.len(), ..Default::default() };
@@ -233,23 +211,9 @@ pub fn target_layout(
         let mut progressed = false;
         let mut postponed = Vec::new();
         for &s in &queue {
-            let p = &src.paths()[s];
-            let (ha, hb) = (2 * s as Half, 2 * s as Half + 1);
-            if group(s) == 2 && !force && rank(s) == usize::MAX {
-                // Postpone while another absent linkage of the pair shares this sector.
-                let ia = present_interval(src, &tid, p.a, ha);
-                let ambiguous = queue.iter().any(|&o| {
-                    o != s && tid[o].is_none() && {
-                        let q = &src.paths()[o];
-                        let ho = if q.a == p.a { 2 * o as Half } else { 2 * o as Half + 1 };
-                        (q.a.min(q.b), q.a.max(q.b)) == (p.a.min(p.b), p.a.max(p.b))
-                            && present_interval(src, &tid, p.a, ho) == ia
-                    }
-                });
-                if ambiguous {
-                    postponed.push(s);
-                    continue;
-                }
+            if order.group[s] == 2 && !force && order.rank[s] == usize::MAX && ambiguous(src, &tid, &queue, s) {
+                postponed.push(s);
+                continue;
             }
             attempts += 1;
             if attempts > opts.max_attempts {
@@ -258,28 +222,13 @@ pub fn target_layout(
                 ))
                 .into());
             }
-            let sector_a = target_sector(src, tgt, &tid, p.a, ha);
-            let sector_b = target_sector(src, tgt, &tid, p.b, hb);
-            // The corridor: target faces in the clusters of the anchors whose source clusters the
-            // source path crosses (its two ends' included). The Voronoi cells guide the path
-            // around the same side of every handle and limb as on the source.
-            let corridor = corridor_of(src, src_clusters, s);
-            let mask: Option<Vec<bool>> =
-                Some(cl.label.iter().map(|&l| l != u32::MAX && corridor.binary_search(&l).is_ok()).collect());
-            let mut req = TraceRequest { a: p.a, b: p.b, faces: mask.as_deref(), sector_a, sector_b, blocked: &[] };
-            let mut got = tgt.trace(&req)?;
-            if got.is_none() && req.faces.is_some() {
-                req.faces = None;
-                attempts += 1;
-                got = tgt.trace(&req)?;
-            }
-            match got {
+            match trace_in_corridor(src, src_clusters, &cl, tgt, &tid, s, &mut attempts)? {
                 Some(path) => {
                     let id = tgt.insert(path)?;
                     tid[s] = Some(id);
                     sid.push(s as u32);
                     progressed = true;
-                    if group(s) == 2 {
+                    if order.group[s] == 2 {
                         stats.multiple_linkages += 1;
                     }
                 }
@@ -296,32 +245,10 @@ pub fn target_layout(
                 queue = postponed;
                 continue;
             }
-            let s = postponed[0];
             if tracing::enabled!(tracing::Level::DEBUG) {
-                for &s in &postponed {
-                    let p = &src.paths()[s];
-                    let free = tgt.trace(&TraceRequest { a: p.a, b: p.b, ..Default::default() })?.is_some();
-                    let sa = target_sector(src, tgt, &tid, p.a, 2 * s as Half);
-                    let sb = target_sector(src, tgt, &tid, p.b, 2 * s as Half + 1);
-                    let only_a =
-                        tgt.trace(&TraceRequest { a: p.a, b: p.b, sector_a: sa, ..Default::default() })?.is_some();
-                    let only_b =
-                        tgt.trace(&TraceRequest { a: p.a, b: p.b, sector_b: sb, ..Default::default() })?.is_some();
-                    tracing::debug!(
-                        "target path {s} {}-{} group {} free {free} only_a {only_a} only_b {only_b} placed {}/{np}",
-                        p.a,
-                        p.b,
-                        group(s),
-                        sid.len()
-                    );
-                    for w in walks(tgt) {
-                        if !w.is_triangle(tgt) {
-                            tracing::debug!("  open walk {:?} halves {:?}", w.corners(tgt), w.halves);
-                        }
-                    }
-                }
+                debug_postponed(src, tgt, &tid, &postponed, &order, sid.len())?;
             }
-            return Ok(Err(s));
+            return Ok(Err(postponed[0]));
         }
         queue = postponed;
     }
@@ -333,6 +260,127 @@ pub fn target_layout(
     }
     stats.paths = np;
     Ok(Ok(stats))
+}
+
+/// The order in which [`target_layout`] traces the source's paths on the target: paths asked
+/// for first (`priority`, a restart's), then by group — 0: a single linkage whose anchors' target
+/// cells share one cut, 1: another single linkage, 2: one of several linkages of an anchor pair —
+/// then shortest source path first.
+struct PathOrder {
+    group: Vec<u8>,
+    rank: Vec<usize>,
+}
+
+impl PathOrder {
+    fn new(src: &Tracer, cl: &Clusters, priority: &[usize]) -> PathOrder {
+        let key = |p: &LayoutPath| (p.a.min(p.b), p.a.max(p.b));
+        let mut linkages = std::collections::HashMap::<(u32, u32), usize>::new();
+        for p in src.paths() {
+            *linkages.entry(key(p)).or_default() += 1;
+        }
+        let group = src
+            .paths()
+            .iter()
+            .map(|p| {
+                if linkages[&key(p)] > 1 {
+                    2
+                } else if cl.between(p.a, p.b).count() == 1 {
+                    0
+                } else {
+                    1
+                }
+            })
+            .collect();
+        let rank =
+            (0..src.paths().len()).map(|s| priority.iter().position(|&p| p == s).unwrap_or(usize::MAX)).collect();
+        PathOrder { group, rank }
+    }
+
+    fn queue(&self, src: &Tracer) -> Vec<usize> {
+        let mut queue: Vec<usize> = (0..src.paths().len()).collect();
+        queue.sort_by(|&x, &y| {
+            (self.rank[x], self.group[x], src.paths()[x].length)
+                .partial_cmp(&(self.rank[y], self.group[y], src.paths()[y].length))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        queue
+    }
+}
+
+/// Whether another absent linkage of path `s`'s anchor pair shares its sector at its first
+/// anchor (then which of them goes where is not yet decided, and `s` waits).
+fn ambiguous(src: &Tracer, tid: &[Option<u32>], queue: &[usize], s: usize) -> bool {
+    let p = &src.paths()[s];
+    let ia = present_interval(src, tid, p.a, 2 * s as Half);
+    queue.iter().any(|&o| {
+        o != s && tid[o].is_none() && {
+            let q = &src.paths()[o];
+            let ho = if q.a == p.a { 2 * o as Half } else { 2 * o as Half + 1 };
+            (q.a.min(q.b), q.a.max(q.b)) == (p.a.min(p.b), p.a.max(p.b)) && present_interval(src, tid, p.a, ho) == ia
+        }
+    })
+}
+
+/// Traces source path `s` on the target between the sectors its neighbours leave, inside its
+/// corridor: the target faces in the clusters of the anchors whose source clusters the source
+/// path crosses (its two ends' included), so it passes every handle and limb on the same side as
+/// on the source; anywhere when the corridor admits no path (one more attempt counted).
+fn trace_in_corridor(
+    src: &Tracer,
+    src_clusters: &Clusters,
+    cl: &Clusters,
+    tgt: &mut Tracer,
+    tid: &[Option<u32>],
+    s: usize,
+    attempts: &mut usize,
+) -> Result<Option<LayoutPath>> {
+    let p = &src.paths()[s];
+    let sector_a = target_sector(src, tgt, tid, p.a, 2 * s as Half);
+    let sector_b = target_sector(src, tgt, tid, p.b, 2 * s as Half + 1);
+    let corridor = corridor_of(src, src_clusters, s);
+    let mask: Option<Vec<bool>> =
+        Some(cl.label.iter().map(|&l| l != u32::MAX && corridor.binary_search(&l).is_ok()).collect());
+    let mut req = TraceRequest { a: p.a, b: p.b, faces: mask.as_deref(), sector_a, sector_b, blocked: &[] };
+    let mut got = tgt.trace(&req)?;
+    if got.is_none() && req.faces.is_some() {
+        req.faces = None;
+        *attempts += 1;
+        got = tgt.trace(&req)?;
+    }
+    Ok(got)
+}
+
+/// Debug events for the paths that could not be placed: whether each could be traced at all,
+/// or with either end's sector alone, and the regions still open.
+fn debug_postponed(
+    src: &Tracer,
+    tgt: &mut Tracer,
+    tid: &[Option<u32>],
+    postponed: &[usize],
+    order: &PathOrder,
+    placed: usize,
+) -> Result<()> {
+    let np = src.paths().len();
+    for &s in postponed {
+        let p = &src.paths()[s];
+        let free = tgt.trace(&TraceRequest { a: p.a, b: p.b, ..Default::default() })?.is_some();
+        let sa = target_sector(src, tgt, tid, p.a, 2 * s as Half);
+        let sb = target_sector(src, tgt, tid, p.b, 2 * s as Half + 1);
+        let only_a = tgt.trace(&TraceRequest { a: p.a, b: p.b, sector_a: sa, ..Default::default() })?.is_some();
+        let only_b = tgt.trace(&TraceRequest { a: p.a, b: p.b, sector_b: sb, ..Default::default() })?.is_some();
+        tracing::debug!(
+            "target path {s} {}-{} group {} free {free} only_a {only_a} only_b {only_b} placed {placed}/{np}",
+            p.a,
+            p.b,
+            order.group[s],
+        );
+        for w in walks(tgt) {
+            if !w.is_triangle(tgt) {
+                tracing::debug!("  open walk {:?} halves {:?}", w.corners(tgt), w.halves);
+            }
+        }
+    }
+    Ok(())
 }
 
 /// [`target_layout`], restarted with each path that could not be traced moved to the front

@@ -134,25 +134,7 @@ pub(crate) fn overlay(input: &OverlayInput) -> Result<MetaMeshResult> {
     let tt = dt.mesh.face_indices();
     let st = ds.mesh.face_indices();
     let alias: HashMap<VKey, VKey> = input.same.iter().copied().collect();
-    // Bucket grid over target triangles.
-    let n = tt.len().max(1);
-    let cells = (n as f64).sqrt().ceil() as usize;
-    let (lo, hi) = ([-1.0f64, -1.0f64], [1.0f64, 1.0f64]);
-    let cw = (hi[0] - lo[0]) / cells as f64;
-    let cell_of = |x: f64, k: usize| (((x - lo[k]) / cw).floor().max(0.0) as usize).min(cells - 1);
-    let mut grid: Vec<Vec<u32>> = vec![Vec::new(); cells * cells];
-    for (f, tri) in tt.iter().enumerate() {
-        let [x0, x1, y0, y1] = bbox(tri.map(|v| ut[v as usize]));
-        for y in cell_of(y0, 1)..=cell_of(y1, 1) {
-            for x in cell_of(x0, 0)..=cell_of(x1, 0) {
-                grid[y * cells + x].push(f as u32);
-            }
-        }
-    }
-    let eps = 1e-12;
-    let so = |v: u32| ds.key[v as usize];
-    let to = |v: u32| dt.key[v as usize];
-    let pair = |a: VKey, b: VKey| if a < b { [a, b] } else { [b, a] };
+    let grid = BucketGrid::new(&tt, ut);
     let mut ids: HashMap<Key, u32> = HashMap::new();
     let mut on_source: Vec<P3> = Vec::new();
     let mut on_target: Vec<P3> = Vec::new();
@@ -171,117 +153,37 @@ pub(crate) fn overlay(input: &OverlayInput) -> Result<MetaMeshResult> {
     };
     for (sf, stri) in st.iter().enumerate() {
         let sp = stri.map(|v| us[v as usize]);
-        let [x0, x1, y0, y1] = bbox(sp);
-        for y in cell_of(y0, 1)..=cell_of(y1, 1) {
-            for x in cell_of(x0, 0)..=cell_of(x1, 0) {
-                for &tf in &grid[y * cells + x] {
-                    if stamp[tf as usize] == sf as u32 {
-                        continue;
+        for &tf in grid.cells(bbox(sp)).flatten() {
+            if stamp[tf as usize] == sf as u32 {
+                continue;
+            }
+            stamp[tf as usize] = sf as u32;
+            let ttri = tt[tf as usize];
+            let tp = ttri.map(|v| ut[v as usize]);
+            let Some(poly) = clip(input, (*stri, sp), (ttri, tp)) else { continue };
+            let mut vid = Vec::with_capacity(poly.len());
+            for pv in &poly {
+                let next_id = on_source.len() as u32;
+                let key = match pv.key {
+                    Key::V(k) => Key::V(alias.get(&k).copied().unwrap_or(k)),
+                    x => x,
+                };
+                let id = *ids.entry(key).or_insert(next_id);
+                if id == next_id {
+                    let ps = point(ds.mesh, *stri, bary(sp, pv.p));
+                    let pt = point(dt.mesh, ttri, bary(tp, pv.p));
+                    on_source.push(ps);
+                    on_target.push(pt);
+                    crossing.push(matches!(key, Key::X(..)));
+                    if matches!(key, Key::X(..)) {
+                        crossings += 1;
                     }
-                    stamp[tf as usize] = sf as u32;
-                    let ttri = tt[tf as usize];
-                    let tp = ttri.map(|v| ut[v as usize]);
-                    let mut poly: Vec<PV> = (0..3)
-                        .map(|k| PV {
-                            p: sp[k],
-                            key: Key::V(so(stri[k])),
-                            next: Support::Src(stri[k], stri[(k + 1) % 3]),
-                        })
-                        .collect();
-                    for j in 0..3 {
-                        let (qa, qb) = (tp[j], tp[(j + 1) % 3]);
-                        let len = ((qb[0] - qa[0]).powi(2) + (qb[1] - qa[1]).powi(2)).sqrt();
-                        if len == 0.0 {
-                            poly.clear();
-                            break;
-                        }
-                        let dist = |p: Uv| cross(qa, qb, p) / len;
-                        let te = (ttri[j], ttri[(j + 1) % 3]);
-                        let mut out = Vec::with_capacity(poly.len() + 2);
-                        for i in 0..poly.len() {
-                            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-                            let (da, db) = (dist(a.p), dist(b.p));
-                            let (ain, bin) = (da >= -eps, db >= -eps);
-                            if ain {
-                                if !bin && da.abs() <= eps {
-                                    out.push(PV { next: Support::Tgt(te.0, te.1), ..a });
-                                    continue;
-                                }
-                                out.push(a);
-                            }
-                            if ain != bin && da.abs() > eps && db.abs() > eps {
-                                let u = da / (da - db);
-                                let ip = [a.p[0] + (b.p[0] - a.p[0]) * u, a.p[1] + (b.p[1] - a.p[1]) * u];
-                                let key = match a.next {
-                                    Support::Tgt(x, y) => {
-                                        // Two target edges meet at their shared vertex.
-                                        let shared = [x, y].into_iter().find(|&v| v == te.0 || v == te.1);
-                                        shared.map_or(Key::V(to(te.0)), |v| Key::V(to(v)))
-                                    }
-                                    Support::Src(x, y) => {
-                                        // Along the target edge: snap to its ends.
-                                        let tl = ((ip[0] - qa[0]) * (qb[0] - qa[0])
-                                            + (ip[1] - qa[1]) * (qb[1] - qa[1]))
-                                            / (len * len);
-                                        if tl <= eps {
-                                            Key::V(to(te.0))
-                                        } else if tl >= 1.0 - eps {
-                                            Key::V(to(te.1))
-                                        } else if u <= eps {
-                                            a.key
-                                        } else if u >= 1.0 - eps {
-                                            b.key
-                                        } else {
-                                            Key::X(pair(so(x), so(y)), pair(to(te.0), to(te.1)))
-                                        }
-                                    }
-                                };
-                                let next = if ain { Support::Tgt(te.0, te.1) } else { a.next };
-                                out.push(PV { p: ip, key, next });
-                            }
-                        }
-                        poly = out;
-                        if poly.len() < 3 {
-                            break;
-                        }
-                    }
-                    // Drop repeated keys (snapped corners) and empty pieces.
-                    poly.dedup_by(|b, a| a.key == b.key);
-                    while poly.len() > 1 && poly[0].key == poly[poly.len() - 1].key {
-                        poly.pop();
-                    }
-                    if poly.len() < 3 {
-                        continue;
-                    }
-                    let area: f64 = (1..poly.len() - 1).map(|k| cross(poly[0].p, poly[k].p, poly[k + 1].p)).sum();
-                    if area <= 1e-24 {
-                        continue;
-                    }
-                    let mut vid = Vec::with_capacity(poly.len());
-                    for pv in &poly {
-                        let next_id = on_source.len() as u32;
-                        let key = match pv.key {
-                            Key::V(k) => Key::V(alias.get(&k).copied().unwrap_or(k)),
-                            x => x,
-                        };
-                        let id = *ids.entry(key).or_insert(next_id);
-                        if id == next_id {
-                            let ps = point(ds.mesh, *stri, bary(sp, pv.p));
-                            let pt = point(dt.mesh, ttri, bary(tp, pv.p));
-                            on_source.push(ps);
-                            on_target.push(pt);
-                            crossing.push(matches!(key, Key::X(..)));
-                            if matches!(key, Key::X(..)) {
-                                crossings += 1;
-                            }
-                        }
-                        vid.push(id);
-                    }
-                    for k in 1..vid.len() - 1 {
-                        if vid[0] != vid[k] && vid[k] != vid[k + 1] && vid[0] != vid[k + 1] {
-                            faces.push([vid[0], vid[k], vid[k + 1]]);
-                        }
-                    }
+                }
+                vid.push(id);
+            }
+            for k in 1..vid.len() - 1 {
+                if vid[0] != vid[k] && vid[k] != vid[k + 1] && vid[0] != vid[k + 1] {
+                    faces.push([vid[0], vid[k], vid[k + 1]]);
                 }
             }
         }
@@ -302,4 +204,121 @@ pub(crate) fn overlay(input: &OverlayInput) -> Result<MetaMeshResult> {
         }
     }
     Ok(MetaMeshResult { faces, on_source, on_target, crossings, crossing })
+}
+
+/// The piece of source triangle `stri` (disk positions `sp`) inside target triangle `ttri`
+/// (`tp`), as a convex polygon whose corners carry their meta-vertex keys (a disk vertex of
+/// either side, or the crossing of a source edge with a target edge), by clipping against the
+/// target triangle's sides in turn; `None` when the piece is empty or without area.
+fn clip(input: &OverlayInput, (stri, sp): ([u32; 3], [Uv; 3]), (ttri, tp): ([u32; 3], [Uv; 3])) -> Option<Vec<PV>> {
+    let eps = 1e-12;
+    let (ds, dt) = (&input.source, &input.target);
+    let so = |v: u32| ds.key[v as usize];
+    let to = |v: u32| dt.key[v as usize];
+    let pair = |a: VKey, b: VKey| if a < b { [a, b] } else { [b, a] };
+    let mut poly: Vec<PV> = (0..3)
+        .map(|k| PV { p: sp[k], key: Key::V(so(stri[k])), next: Support::Src(stri[k], stri[(k + 1) % 3]) })
+        .collect();
+    for j in 0..3 {
+        let (qa, qb) = (tp[j], tp[(j + 1) % 3]);
+        let len = ((qb[0] - qa[0]).powi(2) + (qb[1] - qa[1]).powi(2)).sqrt();
+        if len == 0.0 {
+            poly.clear();
+            break;
+        }
+        let dist = |p: Uv| cross(qa, qb, p) / len;
+        let te = (ttri[j], ttri[(j + 1) % 3]);
+        let mut out = Vec::with_capacity(poly.len() + 2);
+        for i in 0..poly.len() {
+            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+            let (da, db) = (dist(a.p), dist(b.p));
+            let (ain, bin) = (da >= -eps, db >= -eps);
+            if ain {
+                if !bin && da.abs() <= eps {
+                    out.push(PV { next: Support::Tgt(te.0, te.1), ..a });
+                    continue;
+                }
+                out.push(a);
+            }
+            if ain != bin && da.abs() > eps && db.abs() > eps {
+                let u = da / (da - db);
+                let ip = [a.p[0] + (b.p[0] - a.p[0]) * u, a.p[1] + (b.p[1] - a.p[1]) * u];
+                let key = match a.next {
+                    Support::Tgt(x, y) => {
+                        // Two target edges meet at their shared vertex.
+                        let shared = [x, y].into_iter().find(|&v| v == te.0 || v == te.1);
+                        shared.map_or(Key::V(to(te.0)), |v| Key::V(to(v)))
+                    }
+                    Support::Src(x, y) => {
+                        // Along the target edge: snap to its ends.
+                        let tl = ((ip[0] - qa[0]) * (qb[0] - qa[0]) + (ip[1] - qa[1]) * (qb[1] - qa[1])) / (len * len);
+                        if tl <= eps {
+                            Key::V(to(te.0))
+                        } else if tl >= 1.0 - eps {
+                            Key::V(to(te.1))
+                        } else if u <= eps {
+                            a.key
+                        } else if u >= 1.0 - eps {
+                            b.key
+                        } else {
+                            Key::X(pair(so(x), so(y)), pair(to(te.0), to(te.1)))
+                        }
+                    }
+                };
+                let next = if ain { Support::Tgt(te.0, te.1) } else { a.next };
+                out.push(PV { p: ip, key, next });
+            }
+        }
+        poly = out;
+        if poly.len() < 3 {
+            break;
+        }
+    }
+    // Drop repeated keys (snapped corners) and empty pieces.
+    poly.dedup_by(|b, a| a.key == b.key);
+    while poly.len() > 1 && poly[0].key == poly[poly.len() - 1].key {
+        poly.pop();
+    }
+    if poly.len() < 3 {
+        return None;
+    }
+    let area: f64 = (1..poly.len() - 1).map(|k| cross(poly[0].p, poly[k].p, poly[k + 1].p)).sum();
+    (area > 1e-24).then_some(poly)
+}
+
+/// A bucket grid over the target disk's triangles (the disks lie in [-1, 1]²), about one
+/// triangle per cell.
+struct BucketGrid {
+    cells: usize,
+    buckets: Vec<Vec<u32>>,
+}
+
+impl BucketGrid {
+    const LO: [f64; 2] = [-1.0, -1.0];
+    const HI: [f64; 2] = [1.0, 1.0];
+
+    fn new(tris: &[[u32; 3]], uv: &[Uv]) -> BucketGrid {
+        let cells = (tris.len().max(1) as f64).sqrt().ceil() as usize;
+        let mut g = BucketGrid { cells, buckets: vec![Vec::new(); cells * cells] };
+        for (f, tri) in tris.iter().enumerate() {
+            let b = bbox(tri.map(|v| uv[v as usize]));
+            for y in g.cell_of(b[2], 1)..=g.cell_of(b[3], 1) {
+                for x in g.cell_of(b[0], 0)..=g.cell_of(b[1], 0) {
+                    g.buckets[y * cells + x].push(f as u32);
+                }
+            }
+        }
+        g
+    }
+
+    fn cell_of(&self, x: f64, k: usize) -> usize {
+        let cw = (Self::HI[0] - Self::LO[0]) / self.cells as f64;
+        (((x - Self::LO[k]) / cw).floor().max(0.0) as usize).min(self.cells - 1)
+    }
+
+    /// The buckets a bounding box `[x0, x1, y0, y1]` covers, row by row.
+    fn cells(&self, b: [f64; 4]) -> impl Iterator<Item = &Vec<u32>> + '_ {
+        let (xs, ys) = (self.cell_of(b[0], 0)..=self.cell_of(b[1], 0), self.cell_of(b[2], 1)..=self.cell_of(b[3], 1));
+        ys.flat_map(move |y| xs.clone().map(move |x| &self.buckets[y * self.cells + x]))
+    }
 }

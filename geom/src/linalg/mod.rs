@@ -7,5 +7,5 @@ mod solver;
 mod weights;
 
 pub use ordering::{COARSEN_MIN, coarsened_amd};
-pub use solver::{FixedBoundaryFactor, FixedBoundarySystem};
+pub use solver::{FixedBoundaryFactor, FixedBoundarySystem, numeric_llt};
 pub use weights::{DirectedWeights, Weights, directed_weights};

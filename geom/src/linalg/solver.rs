@@ -248,20 +248,7 @@ impl FixedBoundarySystem {
                 .sym_llt
                 .as_ref()
                 .ok_or_else(|| Error::Internal("symmetric factorization without prepare_cholesky()".into()))?;
-            let mut l_values = vec![0.0; sym.len_val()];
-            let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
-                .map_err(|e| Error::Numerical(format!("Cholesky workspace: {e:?}")))?;
-            sym.factorize_numeric_llt::<f64>(
-                &mut l_values,
-                mat,
-                Side::Lower,
-                Default::default(),
-                Par::Seq,
-                MemStack::new(&mut buf),
-                Default::default(),
-            )
-            .map_err(|e| Error::Numerical(format!("Cholesky factorization failed ({n} unknowns): {e:?}")))?;
-            llt = Some(l_values);
+            llt = Some(numeric_llt(sym, mat)?);
         } else {
             let sym = match &self.sym_lu {
                 Some(s) => s.clone(),
@@ -276,6 +263,28 @@ impl FixedBoundarySystem {
         }
         Ok(FixedBoundaryFactor { sys: self, values, coupling, llt, lu })
     }
+}
+
+/// The numeric Cholesky factor's values of `mat` (lower triangle read) on the symbolic
+/// factorization `sym`, as every fixed-pattern system in the crate runs it.
+///
+/// # Errors
+/// `Numerical` when the workspace cannot be allocated or `mat` is not positive definite.
+pub fn numeric_llt(sym: &SymbolicCholesky<usize>, mat: SparseColMatRef<'_, usize, f64>) -> Result<Vec<f64>> {
+    let mut l_values = vec![0.0; sym.len_val()];
+    let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
+        .map_err(|e| Error::Numerical(format!("Cholesky workspace: {e:?}")))?;
+    sym.factorize_numeric_llt::<f64>(
+        &mut l_values,
+        mat,
+        Side::Lower,
+        Default::default(),
+        Par::Seq,
+        MemStack::new(&mut buf),
+        Default::default(),
+    )
+    .map_err(|e| Error::Numerical(format!("Cholesky factorization failed ({} unknowns): {e:?}", mat.ncols())))?;
+    Ok(l_values)
 }
 
 impl FixedBoundaryFactor<'_> {

@@ -140,19 +140,7 @@ impl BlockSystem {
         let pattern = SymbolicSparseColMatRef::new_checked(self.n, self.n, &self.col_ptr, None, &self.row_idx);
         let mat = SparseColMatRef::new(pattern, &values);
         let sym = &self.symbolic;
-        let mut l = vec![0.0; sym.len_val()];
-        let mut buf = MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()))
-            .map_err(|e| Error::Numerical(format!("Cholesky workspace: {e:?}")))?;
-        sym.factorize_numeric_llt::<f64>(
-            &mut l,
-            mat,
-            Side::Lower,
-            Default::default(),
-            Par::Seq,
-            MemStack::new(&mut buf),
-            Default::default(),
-        )
-        .map_err(|e| Error::Numerical(format!("Cholesky factorization failed ({} unknowns): {e:?}", self.n)))?;
+        let l = crate::linalg::numeric_llt(sym, mat)?;
         let mut x = Mat::<f64>::from_fn(self.n, 1, |i, _| rhs[i]);
         let mut buf = MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, Par::Seq))
             .map_err(|e| Error::Numerical(format!("solve workspace: {e:?}")))?;

@@ -404,14 +404,9 @@ mod tests {
     use crate::mesh::shapes;
     use crate::progress::NoProgress;
 
-    /// A square grid whose interior is pushed sideways (`x + 0.3 sin(πx) sin(πy)`, the boundary
-    /// held): injective but far from the rest shape. The optimization brings the energy to its
-    /// minimum (the identity's, four times the area) and every accepted step stays injective.
-    /// A grid with a fold (two interior vertices pushed across their neighbours) is untangled,
-    /// then relaxed without an inverted step.
-    #[test]
-    fn a_folded_grid_is_untangled_then_relaxed() {
-        let m = shapes::grid(6);
+    /// The flat `n` × `n` grid as its own rest shape, boundary fixed; and its rest positions.
+    fn grid_problem(n: usize) -> (InjectiveNewton, Vec<Uv>) {
+        let m = shapes::grid(n);
         let rest_pos: Vec<Uv> = m.positions().iter().map(|p| [p.x, p.y]).collect();
         let tris: Vec<[u32; 3]> = m.faces().iter().map(|f| f.map(|v| v.0)).collect();
         let rest: Vec<RestTriangle> =
@@ -419,6 +414,14 @@ mod tests {
         let boundary: Vec<u32> =
             (0..m.n_vertices() as u32).filter(|&v| m.is_boundary_vertex(crate::VertexId(v))).collect();
         let opt = InjectiveNewton::new(m.n_vertices(), tris, rest, &boundary).unwrap();
+        (opt, rest_pos)
+    }
+
+    /// A grid with a fold (two interior vertices pushed across their neighbours) is untangled,
+    /// then relaxed without an inverted step.
+    #[test]
+    fn a_folded_grid_is_untangled_then_relaxed() {
+        let (opt, rest_pos) = grid_problem(6);
         let mut x = rest_pos.clone();
         // Vertex (2, 2) pushed past (4, 2), and (3, 3) past (1, 3).
         x[2 * 7 + 2] = [0.75, 2.0 / 6.0];
@@ -434,16 +437,12 @@ mod tests {
         assert!((r.energy_after - ideal) / ideal < 1e-3, "{r:?} vs {ideal}");
     }
 
+    /// A square grid whose interior is pushed sideways (`x + 0.3 sin(πx) sin(πy)`, the boundary
+    /// held): injective but far from the rest shape. The optimization brings the energy to its
+    /// minimum (the identity's, four times the area) and every accepted step stays injective.
     #[test]
     fn a_pushed_grid_relaxes_without_ever_inverting() {
-        let m = shapes::grid(8);
-        let rest_pos: Vec<Uv> = m.positions().iter().map(|p| [p.x, p.y]).collect();
-        let tris: Vec<[u32; 3]> = m.faces().iter().map(|f| f.map(|v| v.0)).collect();
-        let rest: Vec<RestTriangle> =
-            tris.iter().map(|t| RestTriangle::new(t.map(|v| rest_pos[v as usize])).unwrap()).collect();
-        let boundary: Vec<u32> =
-            (0..m.n_vertices() as u32).filter(|&v| m.is_boundary_vertex(crate::VertexId(v))).collect();
-        let opt = InjectiveNewton::new(m.n_vertices(), tris, rest, &boundary).unwrap();
+        let (opt, rest_pos) = grid_problem(8);
         let pi = std::f64::consts::PI;
         let mut x: Vec<Uv> =
             rest_pos.iter().map(|p| [p[0] + 0.3 * (pi * p[0]).sin() * (pi * p[1]).sin(), p[1]]).collect();

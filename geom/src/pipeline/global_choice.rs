@@ -101,6 +101,20 @@ pub(super) struct GlobalInputs<'a> {
     pub(super) params: (&'a [crate::crossparam::PatchParam], &'a [crate::crossparam::PatchParam]),
 }
 
+/// The base domain's side lengths: each layout path's length on both meshes, each scaled by
+/// √area, averaged.
+pub(super) fn domain_lengths(inputs: &GlobalInputs, source: &Mesh, target: &Mesh) -> Vec<f64> {
+    let path_len = |r: &Refined, m: &Mesh| -> Vec<f64> {
+        let s = m.area().sqrt().max(f64::MIN_POSITIVE);
+        r.path_vertices
+            .iter()
+            .map(|p| p.windows(2).map(|w| (r.mesh.position(w[1]) - r.mesh.position(w[0])).norm()).sum::<f64>() / s)
+            .collect()
+    };
+    let (rs, rt) = inputs.refined;
+    path_len(rs, source).iter().zip(path_len(rt, target)).map(|(a, b)| 0.5 * (a + b)).collect()
+}
+
 /// Before smoothing, a map pair's distortion energy (symmetric Dirichlet), folded faces and
 /// |area ratio − 1|, both directions summed.
 fn pair_quality(source: &Mesh, target: &Mesh, s2t: &SurfaceMap, t2s: &SurfaceMap) -> Result<(f64, usize, f64)> {
@@ -155,16 +169,7 @@ pub(super) fn choose_global(
     let patches = inputs.patches;
     let is = crate::crossparam::compose::vertex_uv(inputs.params.0, source.n_vertices());
     let it = crate::crossparam::compose::vertex_uv(inputs.params.1, target.n_vertices());
-    // The base domain's side lengths: each path's length on both meshes, each scaled by
-    // √area, averaged.
-    let path_len = |r: &Refined, m: &Mesh| -> Vec<f64> {
-        let s = m.area().sqrt().max(f64::MIN_POSITIVE);
-        r.path_vertices
-            .iter()
-            .map(|p| p.windows(2).map(|w| (r.mesh.position(w[1]) - r.mesh.position(w[0])).norm()).sum::<f64>() / s)
-            .collect()
-    };
-    let lengths: Vec<f64> = path_len(rs, source).iter().zip(path_len(rt, target)).map(|(a, b)| 0.5 * (a + b)).collect();
+    let lengths = domain_lengths(inputs, source, target);
     let lengths = (opts.metric == DomainMetric::PathLengths).then_some(&lengths[..]);
     let mut side = progress.silent();
     let (gs, gt) = both(

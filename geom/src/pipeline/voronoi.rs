@@ -4,7 +4,9 @@
 
 use super::common::relax::{Direction, finish_direction, measure_direction, relax_direction};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
-use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
+use super::global_choice::{
+    GlobalInputs, GlobalReport, RelaxedComparison, choose_global, domain_lengths, relaxed_quality,
+};
 use super::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
 use crate::crossparam::global::GlobalParamOptions;
 use crate::crossparam::{compose, parameterize_patches};
@@ -210,17 +212,10 @@ fn optimized_maps(
     rev: &[(VertexId, VertexId)],
     progress: &mut dyn Progress,
 ) -> Result<(SurfaceMap, SurfaceMap)> {
-    use crate::crossparam::global::{domain_map, locate, seed};
+    use crate::crossparam::global::{domain_map, locate, map_through, seed};
     let (rs, rt) = inputs.refined;
     let (sa, ta) = inputs.anchors;
-    let path_len = |r: &crate::domain::refine::Refined, m: &Mesh| -> Vec<f64> {
-        let s = m.area().sqrt().max(f64::MIN_POSITIVE);
-        r.path_vertices
-            .iter()
-            .map(|p| p.windows(2).map(|w| (r.mesh.position(w[1]) - r.mesh.position(w[0])).norm()).sum::<f64>() / s)
-            .collect()
-    };
-    let lengths: Vec<f64> = path_len(rs, source).iter().zip(path_len(rt, target)).map(|(a, b)| 0.5 * (a + b)).collect();
+    let lengths = domain_lengths(inputs, source, target);
     let is = crate::crossparam::compose::vertex_uv(inputs.params.0, source.n_vertices());
     let it = crate::crossparam::compose::vertex_uv(inputs.params.1, target.n_vertices());
     let mut ss = seed(source, inputs.patches, sa, &is, Some(rs), Some(&lengths))?;
@@ -233,24 +228,7 @@ fn optimized_maps(
     tracing::debug!("optimize: s2t {r1:?}, t2s {r2:?}");
     r1?;
     r2?;
-    let map = |st: &crate::crossparam::global::solve::State,
-               l: &[locate::PatchLocator],
-               to: &Mesh,
-               anchors: &[(VertexId, VertexId)]|
-     -> Result<SurfaceMap> {
-        let mut face = Vec::new();
-        let mut bary = Vec::new();
-        for v in 0..st.uv.len() {
-            let (f, w) =
-                l[st.patch[v] as usize].locate(st.uv[v]).ok_or_else(|| Error::Numerical("no triangle".into()))?;
-            face.push(f);
-            bary.push(w);
-        }
-        let mut m = SurfaceMap { face, bary };
-        crate::crossparam::compose::place_anchors(&mut m, to, anchors);
-        Ok(m)
-    };
-    Ok((map(&ss.state, &tl, target, pairs)?, map(&ts.state, &sl, source, rev)?))
+    Ok((map_through(&ss.state, &tl, target, pairs)?, map_through(&ts.state, &sl, source, rev)?))
 }
 
 /// Runs a `voronoi` or `greedy` job.
@@ -327,7 +305,6 @@ fn run_with(
     let pair = Pair { source, target, pairs: &pairs, rev: &rev, sa: &sa, ta: &ta };
     let relax = o.relax();
     let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = if optimize {
-        let inputs = GlobalInputs { patches: &patches, refined: (&rs, &rt), anchors: (&sa, &ta), params: (&ps, &pt) };
         let (a, b) = optimized_maps(source, target, &inputs, &pairs, &rev, progress)?;
         clock.lap("optimize");
         let (e1, m1) = measure_direction(source, target, &a, &pairs, &relax, progress)?;

@@ -271,12 +271,26 @@ pub fn compose(
     mesh_b: &Mesh,
     anchors: &[(VertexId, VertexId)],
 ) -> Result<SurfaceMap> {
-    let n = a.state.uv.len();
+    map_through(&a.state, &b.locators, mesh_b, anchors)
+}
+
+/// The map from the vertices placed by `st` to B's surface: each located at its chart position
+/// in B's `locators` of the same patch; anchors go exactly to their partners.
+///
+/// # Errors
+/// `Numerical` when a patch of B holds no triangle.
+pub fn map_through(
+    st: &State,
+    locators: &[locate::PatchLocator],
+    mesh_b: &Mesh,
+    anchors: &[(VertexId, VertexId)],
+) -> Result<SurfaceMap> {
+    let n = st.uv.len();
     let mut face = Vec::with_capacity(n);
     let mut bary = Vec::with_capacity(n);
     for v in 0..n {
-        let p = a.state.patch[v];
-        let Some((f, w)) = b.locators[p as usize].locate(a.state.uv[v]) else {
+        let p = st.patch[v];
+        let Some((f, w)) = locators[p as usize].locate(st.uv[v]) else {
             return Err(Error::Numerical(format!("patch {p} holds no triangle of the global map")));
         };
         face.push(f);

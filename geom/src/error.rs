@@ -15,6 +15,10 @@ pub enum Error {
     /// A solve or construction failed numerically (singular system, folded embedding).
     #[error("numerical failure: {0}")]
     Numerical(String),
+    /// The finished map has flipped faces in one direction or both: it is not returned as a
+    /// success. The message gives the counts, where they are and the remedies.
+    #[error("the map folds ({flipped} flipped faces): {detail}")]
+    MapFolds { flipped: usize, detail: String },
     /// The caller asked to stop.
     #[error("cancelled")]
     Cancelled,
@@ -29,6 +33,7 @@ impl Error {
         match self {
             Error::Input(e) => e.code(),
             Error::Numerical(_) => "numerical",
+            Error::MapFolds { .. } => "map_folds",
             Error::Cancelled => "cancelled",
             Error::Internal(_) => "internal",
         }

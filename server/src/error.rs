@@ -58,7 +58,7 @@ impl From<geom::Error> for ApiError {
             geom::Error::Input(geom::InputError::TooLarge { .. }) => {
                 Self::new(StatusCode::PAYLOAD_TOO_LARGE, e.code(), e.to_string())
             }
-            geom::Error::Input(_) | geom::Error::Numerical(_) => {
+            geom::Error::Input(_) | geom::Error::Numerical(_) | geom::Error::MapFolds { .. } => {
                 Self::new(StatusCode::UNPROCESSABLE_ENTITY, e.code(), e.to_string())
             }
             geom::Error::Cancelled => Self::new(StatusCode::CONFLICT, "cancelled", "cancelled"),

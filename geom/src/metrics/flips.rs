@@ -5,9 +5,9 @@
 use super::surface_index::{Nearest, SurfaceIndex, centroid};
 use crate::mesh::{FaceId, Mesh};
 
-/// Counts inverted faces of `mapped` on `target`; `vertex_nearest` are the nearest-surface
-/// answers for the mapped vertices (reused from the off-surface measurement).
-pub fn flipped_faces(mapped: &Mesh, target: &Mesh, index: &SurfaceIndex, vertex_nearest: &[Nearest]) -> usize {
+/// The inverted faces of `mapped` on `target`, in increasing order; `vertex_nearest` are the
+/// nearest-surface answers for the mapped vertices (reused from the off-surface measurement).
+pub fn flipped_faces(mapped: &Mesh, target: &Mesh, index: &SurfaceIndex, vertex_nearest: &[Nearest]) -> Vec<usize> {
     let tn: Vec<_> = (0..target.n_faces())
         .map(|f| {
             let n = target.face_normal_raw(FaceId::from_idx(f));
@@ -25,11 +25,10 @@ pub fn flipped_faces(mapped: &Mesh, target: &Mesh, index: &SurfaceIndex, vertex_
         .collect();
     let cents: Vec<_> = suspects.iter().map(|&f| centroid(mapped.face_points(FaceId::from_idx(f)))).collect();
     let at_centroid = index.query_all(&cents);
-    let mut count = 0;
-    for (&fi, c) in suspects.iter().zip(&at_centroid) {
-        if opposes(&mapped.face_normal_raw(FaceId::from_idx(fi)), c.face) {
-            count += 1;
-        }
-    }
-    count
+    suspects
+        .iter()
+        .zip(&at_centroid)
+        .filter(|(fi, c)| opposes(&mapped.face_normal_raw(FaceId::from_idx(**fi)), c.face))
+        .map(|(&fi, _)| fi)
+        .collect()
 }

@@ -38,6 +38,9 @@ impl Default for MetricsOptions {
     }
 }
 
+/// How many flipped faces a report lists by id.
+pub const MAX_LISTED_FLIPS: usize = 100;
+
 /// The evaluator's keys.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MapMetrics {
@@ -46,6 +49,10 @@ pub struct MapMetrics {
     pub off_surface_max: f64,
     pub off_surface_mean: f64,
     pub flipped_faces: usize,
+    /// The first [`MAX_LISTED_FLIPS`] flipped faces (face ids of the mapped mesh, increasing):
+    /// where a folded map folds. Not an evaluator key; absent when there are none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub flipped_face_ids: Vec<usize>,
     pub area_ratio: f64,
     pub l2_stretch: f64,
     pub linf_stretch: f64,
@@ -139,7 +146,8 @@ pub fn evaluate_map(
         faces: source.n_faces(),
         off_surface_max: off_max / diag,
         off_surface_mean: off_mean / diag,
-        flipped_faces: flipped,
+        flipped_faces: flipped.len(),
+        flipped_face_ids: flipped.iter().copied().take(MAX_LISTED_FLIPS).collect(),
         area_ratio,
         l2_stretch: d.l2_stretch,
         linf_stretch: d.linf_stretch,

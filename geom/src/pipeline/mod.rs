@@ -9,6 +9,7 @@
 mod check;
 pub mod common;
 pub mod features;
+mod folds;
 mod global_choice;
 pub mod homology;
 mod limits;
@@ -65,8 +66,10 @@ impl JobReport {
 
 /// Runs any job on its meshes (two for pair jobs, in source, target order).
 ///
+/// A result with flipped faces is not a success: it fails with `MapFolds` (see [`folds`]).
+///
 /// # Errors
-/// `InputError::Spec` for the wrong number of meshes; whatever the method reports.
+/// `InputError::Spec` for the wrong number of meshes; `MapFolds`; whatever the method reports.
 pub fn run_job(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Result<(JobReport, Vec<Artifact>)> {
     let pair = || match meshes {
         [s, t] => Ok((s, t)),
@@ -76,7 +79,7 @@ pub fn run_job(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> 
             meshes.len()
         ))),
     };
-    Ok(match spec {
+    let (mut report, mut arts) = match spec {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => {
             let (a, b) = pair()?;
             let (r, arts) = voronoi::run(spec.method(), s, a, b, progress)?;
@@ -96,7 +99,9 @@ pub fn run_job(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> 
             let (r, arts) = quad::run(s, meshes, progress)?;
             (JobReport::Quad(r), arts)
         }
-    })
+    };
+    folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
+    Ok((report, arts))
 }
 #[cfg(test)]
 mod cancel_tests {

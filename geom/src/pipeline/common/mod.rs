@@ -76,6 +76,10 @@ pub struct PairReport {
     /// Milliseconds per stage.
     pub timings_ms: Vec<(String, f64)>,
     pub smoothing: SmoothReport,
+    /// Vertex-map artifacts not written because that direction folds (only when a fold-free
+    /// meta-mesh pair was built instead; otherwise a folded map fails the job).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub withheld: Vec<String>,
 }
 
 impl PairReport {
@@ -95,6 +99,7 @@ impl PairReport {
             target_to_source: metrics.1,
             timings_ms: Vec::new(),
             smoothing,
+            withheld: Vec::new(),
         }
     }
 }

@@ -30,6 +30,7 @@ pub enum Stage {
     Parameterize,
     Compose,
     Global,
+    Optimize,
     Smooth,
     Basis,
     FeatureCut,
@@ -44,7 +45,7 @@ pub enum Stage {
 
 impl Stage {
     /// Every stage.
-    pub const ALL: [Stage; 18] = [
+    pub const ALL: [Stage; 19] = [
         Stage::Layout,
         Stage::LayoutSource,
         Stage::LayoutTarget,
@@ -53,6 +54,7 @@ impl Stage {
         Stage::Parameterize,
         Stage::Compose,
         Stage::Global,
+        Stage::Optimize,
         Stage::Smooth,
         Stage::Basis,
         Stage::FeatureCut,
@@ -76,6 +78,7 @@ impl Stage {
             Stage::Parameterize => "parameterize",
             Stage::Compose => "compose",
             Stage::Global => "global",
+            Stage::Optimize => "optimize",
             Stage::Smooth => "smooth",
             Stage::Basis => "basis",
             Stage::FeatureCut => "feature_cut",

@@ -276,9 +276,11 @@ impl InjectiveNewton {
                 .ok_or_else(|| Error::Internal("an inverted triangle inside the optimization".into()))?;
             let dir = self.direction(d, s, &metrics)?;
             let Some((next, e, backtracks)) = self.line_search(d, s, &dir, &metrics, energy, opts) else {
+                tracing::debug!(iteration = r.iterations, energy, slope = dir.1, "no step lowers the energy");
                 r.converged = true;
                 break;
             };
+            tracing::debug!(iteration = r.iterations, energy, e, backtracks, "newton step");
             r.iterations += 1;
             r.backtracks += backtracks;
             *s = next;
@@ -384,9 +386,13 @@ impl InjectiveNewton {
         let mut backtracks = 0;
         while t > 1e-12 {
             let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
+            // The frozen metrics give the direction and the Armijo test; the step must also
+            // lower the energy under the metrics where the trial lands (a long step crosses
+            // many target faces, and the frozen energy alone let it wander uphill).
             if let Some(trial) = d.moved(s, &step)
-                && let Some(e) = self.energy_with(d, &trial, metrics)
-                && e <= energy + 1e-4 * t * slope
+                && self.energy_with(d, &trial, metrics).is_some_and(|e| e <= energy + 1e-4 * t * slope)
+                && let Some(e) = self.energy(d, &trial)
+                && e < energy
                 && self.is_injective(d, &trial)
             {
                 return Some((trial, e, backtracks));

@@ -14,6 +14,7 @@ mod global_choice;
 pub mod homology;
 mod limits;
 mod memory;
+mod optimize;
 pub mod quad;
 mod quad_spec;
 mod ranges;

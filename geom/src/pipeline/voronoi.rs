@@ -4,9 +4,8 @@
 
 use super::common::relax::{Direction, finish_direction, measure_direction, relax_direction};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
-use super::global_choice::{
-    GlobalInputs, GlobalReport, RelaxedComparison, choose_global, domain_lengths, relaxed_quality,
-};
+use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
+use super::optimize::{self, OptimizeReport};
 use super::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
 use crate::crossparam::global::GlobalParamOptions;
 use crate::crossparam::{compose, parameterize_patches};
@@ -30,6 +29,9 @@ pub struct LayoutMapReport {
     /// The global map onto the base domain, when it was tried.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub global: Option<GlobalReport>,
+    /// The optimization in the base domain, when the composed maps were far from isometric.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub optimize: Option<Box<OptimizeReport>>,
 }
 
 /// A layout conflict's message, naming the source anchors whose Voronoi cells are not disks
@@ -200,37 +202,6 @@ impl Pair<'_> {
     }
 }
 
-/// Both directions optimized in the base domain ([`crate::crossparam::global::domain_map`]),
-/// each from its per-patch maps against the other mesh's per-patch maps. Not yet a stage of
-/// the pipeline (issue 35): its figures are in `bench/NOTES.md`; tests reach it through
-/// [`run_with`].
-fn optimized_maps(
-    source: &Mesh,
-    target: &Mesh,
-    inputs: &GlobalInputs,
-    pairs: &[(VertexId, VertexId)],
-    rev: &[(VertexId, VertexId)],
-    progress: &mut dyn Progress,
-) -> Result<(SurfaceMap, SurfaceMap)> {
-    use crate::crossparam::global::{domain_map, locate, map_through, seed};
-    let (rs, rt) = inputs.refined;
-    let (sa, ta) = inputs.anchors;
-    let lengths = domain_lengths(inputs, source, target);
-    let is = crate::crossparam::compose::vertex_uv(inputs.params.0, source.n_vertices());
-    let it = crate::crossparam::compose::vertex_uv(inputs.params.1, target.n_vertices());
-    let mut ss = seed(source, inputs.patches, sa, &is, Some(rs), Some(&lengths))?;
-    let mut ts = seed(target, inputs.patches, ta, &it, Some(rt), Some(&lengths))?;
-    let sl = locate::locators(source, &ss.charts, &ss.state, &ss.rows, &ss.fixed);
-    let tl = locate::locators(target, &ts.charts, &ts.state, &ts.rows, &ts.fixed);
-    let opts = crate::optim::InjectiveNewtonOptions { max_iterations: 50, ..Default::default() };
-    let r1 = domain_map::optimize(source, &mut ss, target, &tl, &opts, progress);
-    let r2 = domain_map::optimize(target, &mut ts, source, &sl, &opts, progress);
-    tracing::debug!("optimize: s2t {r1:?}, t2s {r2:?}");
-    r1?;
-    r2?;
-    Ok((map_through(&ss.state, &tl, target, pairs)?, map_through(&ts.state, &sl, source, rev)?))
-}
-
 /// Runs a `voronoi` or `greedy` job.
 ///
 /// # Errors
@@ -244,16 +215,16 @@ pub fn run(
     progress: &mut dyn Progress,
 ) -> Result<(LayoutMapReport, Vec<Artifact>)> {
     let go = GlobalParamOptions { enabled: spec.options.global.enabled, ..Default::default() };
-    run_with(method, spec, &go, false, source, target, progress)
+    run_with(method, spec, &go, optimize::GATE, source, target, progress)
 }
 
-/// [`run`] with every option of the global map (tests force it) and, with `optimize`, the
-/// maps optimized in the base domain instead of relaxed (tests of that building block).
+/// [`run`] with every option of the global map (tests force it) and the optimization's gate
+/// (tests open it with 0).
 fn run_with(
     method: Method,
     spec: &LayoutSpec,
     go: &GlobalParamOptions,
-    optimize: bool,
+    gate: f64,
     source: &Mesh,
     target: &Mesh,
     progress: &mut dyn Progress,
@@ -299,28 +270,27 @@ fn run_with(
         both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
     clock.lap("compose");
     let inputs = GlobalInputs { patches: &patches, refined: (&rs, &rt), anchors: (&sa, &ta), params: (&ps, &pt) };
-    let (maps, contender, mut global) = choose_global(source, target, &inputs, (s2t, t2s), &pairs, &rev, go, progress)?;
+    let (mut maps, mut contender, mut global) =
+        choose_global(source, target, &inputs, (s2t, t2s), &pairs, &rev, go, progress)?;
     clock.lap("global");
     progress.check()?;
+    let optimized = optimize::optimize_maps((source, target), &inputs, [&pairs, &rev], &mut maps, gate, progress)?;
+    if optimized.as_ref().is_some_and(|r| r.used.iter().any(|u| *u != "composed")) {
+        contender = None;
+    }
+    clock.lap("optimize");
     let pair = Pair { source, target, pairs: &pairs, rev: &rev, sa: &sa, ta: &ta };
     let relax = o.relax();
-    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = if optimize {
-        let (a, b) = optimized_maps(source, target, &inputs, &pairs, &rev, progress)?;
-        clock.lap("optimize");
-        let (e1, m1) = measure_direction(source, target, &a, &pairs, &relax, progress)?;
-        let (e2, m2) = measure_direction(target, source, &b, &rev, &relax, progress)?;
-        ((a, Default::default(), e1, m1), (b, Default::default(), e2, m2))
-    } else {
-        match contender {
-            None => pair.finish(maps, &relax, &mut clock, progress)?,
-            Some(g) => pair.finish_contest(maps, g, &relax, &mut global, &mut clock, progress)?,
-        }
+    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = match contender {
+        None => pair.finish(maps, &relax, &mut clock, progress)?,
+        Some(g) => pair.finish_contest(maps, g, &relax, &mut global, &mut clock, progress)?,
     };
     clock.lap("metrics");
     progress.check()?;
     let metrics = (m1, m2);
     let pair = PairReport::new(method.name(), pairs.len(), (source, target), metrics, r1.merge(r2));
-    let mut report = LayoutMapReport { pair, patches: patches.len(), layout: stats, global };
+    let mut report =
+        LayoutMapReport { pair, patches: patches.len(), layout: stats, global, optimize: optimized.map(Box::new) };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, (&s2t, &t2s), &on_target, &on_source)?;
     clock.lap("artifacts");
     report.pair.timings_ms = clock.finish();
@@ -365,7 +335,7 @@ mod tests {
         options.smoothing.iterations = 0;
         let spec = LayoutSpec { anchors: (0..12).map(|i| [i, i]).collect(), options };
         let go = GlobalParamOptions { force: true, ..Default::default() };
-        let (r, arts) = run_with(Method::Voronoi, &spec, &go, false, &m, &m, &mut NoProgress).unwrap();
+        let (r, arts) = run_with(Method::Voronoi, &spec, &go, optimize::GATE, &m, &m, &mut NoProgress).unwrap();
         let g = r.global.unwrap();
         assert!(g.used);
         assert_eq!(r.patches, 20);
@@ -381,9 +351,10 @@ mod tests {
         assert_eq!(r.pair.source_to_target.flipped_faces, 0);
     }
 
-    /// The base-domain optimization (issue 35's building block) on an icosphere onto a
-    /// stretched copy: both directions come out without a flip, anchors exact, and less
-    /// distorted than the per-patch composition it starts from.
+    /// The base-domain optimization stage (gate opened) on an icosphere onto a stretched copy:
+    /// both directions come out without a flip, anchors exact, lower in energy than the
+    /// per-patch composition it starts from and less distorted after the same relaxation; a
+    /// gate above the maps' energy skips the stage.
     #[test]
     fn the_domain_optimization_maps_both_ways_without_flips() {
         let s = shapes::icosphere(3);
@@ -396,8 +367,14 @@ mod tests {
         options.global.enabled = false;
         let spec = LayoutSpec { anchors, options };
         let go = GlobalParamOptions { enabled: false, ..Default::default() };
-        let (plain, _) = run_with(Method::Voronoi, &spec, &go, false, &s, &t, &mut NoProgress).unwrap();
-        let (opt, _) = run_with(Method::Voronoi, &spec, &go, true, &s, &t, &mut NoProgress).unwrap();
+        let (plain, _) = run_with(Method::Voronoi, &spec, &go, f64::INFINITY, &s, &t, &mut NoProgress).unwrap();
+        let (opt, _) = run_with(Method::Voronoi, &spec, &go, 0.0, &s, &t, &mut NoProgress).unwrap();
+        assert!(plain.optimize.is_none(), "the closed gate skips the stage");
+        let r = opt.optimize.as_ref().expect("the open gate runs the stage");
+        for d in 0..2 {
+            assert_ne!(r.used[d], "composed", "{r:?}");
+            assert!(r.energy_after[d] < r.energy_before[d], "{r:?}");
+        }
         let pairs = [
             (&opt.pair.source_to_target, &plain.pair.source_to_target),
             (&opt.pair.target_to_source, &plain.pair.target_to_source),

@@ -1,0 +1,138 @@
+//! The base-domain optimization of `voronoi` and `greedy` maps (issue 35): both directions
+//! optimized as a whole in the common base domain ([`crate::crossparam::global::domain_map`]:
+//! symmetric Dirichlet, injective projected Newton), before the relaxation polishes them.
+//!
+//! Each mesh's images start from its global (or per-patch) map onto the domain and move against
+//! the other mesh's seed. An optimized direction also yields the other as its inverse: the
+//! other mesh's seed located among the optimized images. Per direction the candidate of lower
+//! energy replaces the composed map when it is lower in energy than the composed map.
+//!
+//! It runs only where the composed maps are far from isometric (normalized energy above
+//! [`GATE`]): on same-shape pairs the relaxation alone is as good and the optimization would
+//! cost seconds (figures in `bench/NOTES.md`).
+
+use super::global_choice::{GlobalInputs, domain_lengths};
+use crate::crossparam::global::domain_map::{self, DomainMapReport};
+use crate::crossparam::global::{locate, map_through, seed};
+use crate::crossparam::smooth::SourceFrame;
+use crate::error::Result;
+use crate::map::SurfaceMap;
+use crate::mesh::{Mesh, P3, VertexId};
+use crate::optim::InjectiveNewtonOptions;
+use crate::progress::{Progress, Stage};
+use serde::Serialize;
+
+/// Normalized energy (1 for an isometry, the larger of both directions) above which the
+/// composed maps are optimized.
+pub const GATE: f64 = 1.25;
+
+/// A face's energy counts at most this many times the isometric energy.
+const FACE_CAP: f64 = 10.0;
+
+/// Newton iterations per direction.
+const ITERATIONS: usize = 50;
+
+/// What the optimization did, per direction (source → target, target → source).
+#[derive(Debug, Clone, Serialize)]
+pub struct OptimizeReport {
+    /// Symmetric Dirichlet energy over four times the mapped mesh's area (1 for an isometry):
+    /// the composed map, and the map kept.
+    pub energy_before: [f64; 2],
+    pub energy_after: [f64; 2],
+    /// Which map was kept: `direct` (this direction optimized), `inverse` (the other
+    /// direction's, inverted) or `composed` (neither was lower in energy, or none was injective).
+    pub used: [&'static str; 2],
+    pub source: DomainMapReport,
+    pub target: DomainMapReport,
+}
+
+/// Normalized energy of `map` from `from` onto `to`: the symmetric Dirichlet energy of its
+/// chords over four times the source's area, each face's share capped at [`FACE_CAP`] times the
+/// isometric one, so a few faces mapped nearly flat (which the relaxation repairs) do not
+/// outweigh the distortion of the whole map.
+fn normalized(from: &Mesh, to: &Mesh, map: &SurfaceMap) -> f64 {
+    let scale = (from.area() / to.area().max(f64::MIN_POSITIVE)).sqrt();
+    let pos: Vec<P3> = (0..from.n_vertices()).map(|v| map.position(VertexId::from_idx(v), to)).collect();
+    let mut sum = 0.0;
+    for f in from.faces() {
+        if let Some(fr) = SourceFrame::new(f.map(|w| from.position(w))) {
+            let cap = 4.0 * FACE_CAP * fr.area();
+            sum += fr.energy(f.map(|w| pos[w.idx()]), scale).map_or(cap, |e| e.min(cap));
+        }
+    }
+    sum / (4.0 * from.area().max(f64::MIN_POSITIVE))
+}
+
+/// Optimizes `maps` (source → target, target → source) in place when their normalized energy
+/// is above `gate` ([`GATE`] in jobs); `None` when it was not.
+///
+/// # Errors
+/// `Numerical` when a Newton system cannot be solved; `Cancelled`.
+pub(super) fn optimize_maps(
+    (source, target): (&Mesh, &Mesh),
+    inputs: &GlobalInputs,
+    [pairs, rev]: [&[(VertexId, VertexId)]; 2],
+    maps: &mut (SurfaceMap, SurfaceMap),
+    gate: f64,
+    progress: &mut dyn Progress,
+) -> Result<Option<OptimizeReport>> {
+    let before = [normalized(source, target, &maps.0), normalized(target, source, &maps.1)];
+    if before[0].max(before[1]) <= gate {
+        return Ok(None);
+    }
+    progress.report(Stage::Optimize, 0.0);
+    let (rs, rt) = inputs.refined;
+    let (sa, ta) = inputs.anchors;
+    let lengths = domain_lengths(inputs, source, target);
+    let is = crate::crossparam::compose::vertex_uv(inputs.params.0, source.n_vertices());
+    let it = crate::crossparam::compose::vertex_uv(inputs.params.1, target.n_vertices());
+    let mut ss = seed(source, inputs.patches, sa, &is, Some(rs), Some(&lengths))?;
+    let mut ts = seed(target, inputs.patches, ta, &it, Some(rt), Some(&lengths))?;
+    let sl = locate::locators(source, &ss.charts, &ss.state, &ss.rows, &ss.fixed);
+    let tl = locate::locators(target, &ts.charts, &ts.state, &ts.rows, &ts.fixed);
+    let opts = InjectiveNewtonOptions { max_iterations: ITERATIONS, ..Default::default() };
+    let (s0, t0) = (ss.state.clone(), ts.state.clone());
+    let r1 = domain_map::optimize(source, &mut ss, target, &tl, &opts, progress)?;
+    progress.report(Stage::Optimize, 0.5);
+    let r2 = domain_map::optimize(target, &mut ts, source, &sl, &opts, progress)?;
+    let (s_ok, t_ok) = (r1.newton.is_some(), r2.newton.is_some());
+    let (s0_ok, t0_ok) = (r1.folded_at_start == 0, r2.folded_at_start == 0);
+    let slo = locate::locators(source, &ss.charts, &ss.state, &ss.rows, &ss.fixed);
+    let tlo = locate::locators(target, &ts.charts, &ts.state, &ts.rows, &ts.fixed);
+    let mut c1 = Vec::new();
+    if s_ok {
+        c1.push(("direct", map_through(&ss.state, &tl, target, pairs)?));
+    }
+    if t_ok && s0_ok {
+        c1.push(("inverse", map_through(&s0, &tlo, target, pairs)?));
+    }
+    let mut c2 = Vec::new();
+    if t_ok {
+        c2.push(("direct", map_through(&ts.state, &sl, source, rev)?));
+    }
+    if s_ok && t0_ok {
+        c2.push(("inverse", map_through(&t0, &slo, source, rev)?));
+    }
+    let (e1, u1) = keep_lowest(source, target, &mut maps.0, before[0], c1);
+    let (e2, u2) = keep_lowest(target, source, &mut maps.1, before[1], c2);
+    Ok(Some(OptimizeReport { energy_before: before, energy_after: [e1, e2], used: [u1, u2], source: r1, target: r2 }))
+}
+
+/// Replaces `map` by the candidate of lowest energy when it is lower than `energy`.
+fn keep_lowest(
+    from: &Mesh,
+    to: &Mesh,
+    map: &mut SurfaceMap,
+    energy: f64,
+    candidates: Vec<(&'static str, SurfaceMap)>,
+) -> (f64, &'static str) {
+    let best =
+        candidates.into_iter().map(|(name, m)| (normalized(from, to, &m), name, m)).min_by(|a, b| a.0.total_cmp(&b.0));
+    match best {
+        Some((e, name, m)) if e < energy => {
+            *map = m;
+            (e, name)
+        }
+        _ => (energy, "composed"),
+    }
+}

@@ -158,7 +158,7 @@ impl Pair<'_> {
         p: (SurfaceMap, SurfaceMap),
         g: (SurfaceMap, SurfaceMap),
         o: &RelaxOptions,
-        report: &mut Option<GlobalReport>,
+        decide: impl FnOnce(RelaxedComparison) -> bool,
         clock: &mut Clock,
         progress: &mut dyn Progress,
     ) -> Result<(Direction, Direction)> {
@@ -182,7 +182,7 @@ impl Pair<'_> {
         let ((ps, gs, qps, qgs), (pt, gt, qpt, qgt)) = (x?, y?);
         clock.lap("smooth");
         let cmp = RelaxedComparison::new([qps, qpt], [qgs, qgt]);
-        let use_global = report.as_mut().map_or(cmp.prefers_global(), |r| r.record_relaxed(cmp));
+        let use_global = decide(cmp);
         let ((s2t, r1), (t2s, r2)) = if use_global { (gs, gt) } else { (ps, pt) };
         let measure = |from: &Mesh,
                        to: &Mesh,
@@ -270,27 +270,35 @@ fn run_with(
         both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
     clock.lap("compose");
     let inputs = GlobalInputs { patches: &patches, refined: (&rs, &rt), anchors: (&sa, &ta), params: (&ps, &pt) };
-    let (mut maps, mut contender, mut global) =
-        choose_global(source, target, &inputs, (s2t, t2s), &pairs, &rev, go, progress)?;
+    let (maps, contender, mut global) = choose_global(source, target, &inputs, (s2t, t2s), &pairs, &rev, go, progress)?;
     clock.lap("global");
     progress.check()?;
-    let optimized = optimize::optimize_maps((source, target), &inputs, [&pairs, &rev], &mut maps, gate, progress)?;
-    if optimized.as_ref().is_some_and(|r| r.used.iter().any(|u| *u != "composed")) {
-        contender = None;
-    }
+    let optimized = optimize::optimize_maps((source, target), &inputs, [&pairs, &rev], &maps, gate, progress)?;
     clock.lap("optimize");
     let pair = Pair { source, target, pairs: &pairs, rev: &rev, sa: &sa, ta: &ta };
     let relax = o.relax();
-    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = match contender {
-        None => pair.finish(maps, &relax, &mut clock, progress)?,
-        Some(g) => pair.finish_contest(maps, g, &relax, &mut global, &mut clock, progress)?,
-    };
+    // The optimized maps, when any direction changed, contend with the composed ones after
+    // relaxation (instead of the global maps: the composed maps already are the better of
+    // per-patch and global before relaxation).
+    let mut optimized = optimized.map(Box::new);
+    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) =
+        match (optimized.as_mut().and_then(|r| r.maps.take()), contender) {
+            (Some(g), _) => {
+                let decide = |cmp: RelaxedComparison| optimized.as_mut().is_some_and(|r| r.record_relaxed(cmp));
+                pair.finish_contest(maps, g, &relax, decide, &mut clock, progress)?
+            }
+            (None, None) => pair.finish(maps, &relax, &mut clock, progress)?,
+            (None, Some(g)) => {
+                let decide =
+                    |cmp: RelaxedComparison| global.as_mut().map_or(cmp.prefers_global(), |r| r.record_relaxed(cmp));
+                pair.finish_contest(maps, g, &relax, decide, &mut clock, progress)?
+            }
+        };
     clock.lap("metrics");
     progress.check()?;
     let metrics = (m1, m2);
     let pair = PairReport::new(method.name(), pairs.len(), (source, target), metrics, r1.merge(r2));
-    let mut report =
-        LayoutMapReport { pair, patches: patches.len(), layout: stats, global, optimize: optimized.map(Box::new) };
+    let mut report = LayoutMapReport { pair, patches: patches.len(), layout: stats, global, optimize: optimized };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, (&s2t, &t2s), &on_target, &on_source)?;
     clock.lap("artifacts");
     report.pair.timings_ms = clock.finish();

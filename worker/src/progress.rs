@@ -73,9 +73,9 @@ mod tests {
     fn fraction_is_monotone_and_cancel_is_seen() {
         let mut s = Shared::default();
         s.report(Stage::Smooth, 0.5);
-        assert_eq!(s.snapshot(), ("smooth".to_string(), 0.7));
+        assert_eq!(s.snapshot(), ("smooth".to_string(), 0.725));
         s.report(Stage::Layout, 1.0);
-        assert_eq!(s.snapshot().1, 0.7);
+        assert_eq!(s.snapshot().1, 0.725);
         assert!(s.check().is_ok());
         let side = s.silent();
         assert!(side.check().is_ok());

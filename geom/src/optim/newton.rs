@@ -220,7 +220,10 @@ impl InjectiveNewton {
         if *slope >= 0.0 {
             return None;
         }
-        let mut t = 1.0;
+        // No vertex moves farther than a typical edge in one step: a long jump across chart
+        // sides can land a vertex on another sheet around a cone, a fold no step undoes.
+        let longest = dir.iter().map(|q| q[0].hypot(q[1])).fold(0.0, f64::max);
+        let mut t = if longest > 0.0 { (self.typical_edge(d, s) / longest).min(1.0) } else { 1.0 };
         while t > 1e-12 {
             let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
             if let Some(trial) = d.moved(s, &step)
@@ -232,6 +235,23 @@ impl InjectiveNewton {
             t *= 0.5;
         }
         None
+    }
+
+    /// The median edge length of the triangles in their charts.
+    fn typical_edge<D: MapDomain>(&self, d: &D, s: &D::State) -> f64 {
+        let mut l: Vec<f64> = self
+            .triangles
+            .iter()
+            .map(|&tri| {
+                let x = d.element(s, tri).0;
+                (x[1][0] - x[0][0]).hypot(x[1][1] - x[0][1])
+            })
+            .collect();
+        if l.is_empty() {
+            return 0.0;
+        }
+        let mid = l.len() / 2;
+        *l.select_nth_unstable_by(mid, f64::total_cmp).1
     }
 
     /// Whether every triangle is positively oriented in its chart under the exact predicate.

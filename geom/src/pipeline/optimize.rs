@@ -15,8 +15,8 @@
 //! after seconds of work (figures in `bench/NOTES.md`).
 
 use super::global_choice::{GlobalInputs, RelaxedComparison, domain_lengths};
-use crate::crossparam::global::domain_map::{self, DomainMapReport};
-use crate::crossparam::global::{locate, map_through, seed};
+use crate::crossparam::global::domain_map::{DomainMapReport, DomainOptimizer};
+use crate::crossparam::global::{Seed, locate, map_through, seed};
 use crate::crossparam::smooth::SourceFrame;
 use crate::error::Result;
 use crate::map::SurfaceMap;
@@ -101,6 +101,7 @@ pub(super) fn optimize_maps(
     progress: &mut dyn Progress,
 ) -> Result<Option<OptimizeReport>> {
     let before = [normalized(source, target, &maps.0), normalized(target, source, &maps.1)];
+    tracing::debug!(?before, gate, "optimization gate");
     if before[0].max(before[1]) <= gate {
         return Ok(None);
     }
@@ -112,37 +113,38 @@ pub(super) fn optimize_maps(
     let it = crate::crossparam::compose::vertex_uv(inputs.params.1, target.n_vertices());
     let mut ss = seed(source, inputs.patches, sa, &is, Some(rs), Some(&lengths))?;
     let mut ts = seed(target, inputs.patches, ta, &it, Some(rt), Some(&lengths))?;
-    let sl = locate::locators(source, &ss.charts, &ss.state, &ss.rows, &ss.fixed);
-    let tl = locate::locators(target, &ts.charts, &ts.state, &ts.rows, &ts.fixed);
     let opts = InjectiveNewtonOptions { max_iterations: ITERATIONS, ..Default::default() };
+    let (so, to) = (DomainOptimizer::new(source, &ss)?, DomainOptimizer::new(target, &ts)?);
+    let locators = |m: &Mesh, x: &Seed| locate::locators(m, &x.charts, &x.state, &x.rows, &x.fixed);
+    // Both seeds untangled first (each measured against the other's seed), so each mesh's
+    // optimization measures against an injective map of the other.
+    let (sl, tl) = (locators(source, &ss), locators(target, &ts));
+    let (s_fold, t_fold) = (so.untangle(&mut ss, target, &tl, progress)?, to.untangle(&mut ts, source, &sl, progress)?);
+    let sl = if s_fold.0 > 0 { locators(source, &ss) } else { sl };
+    let tl = if t_fold.0 > 0 { locators(target, &ts) } else { tl };
     let (s0, t0) = (ss.state.clone(), ts.state.clone());
-    let r1 = domain_map::optimize(source, &mut ss, target, &tl, &opts, progress)?;
+    let n1 = if t_fold.1 == 0 { so.minimize(&mut ss, target, &tl, &opts, progress)? } else { None };
     progress.report(Stage::Optimize, 0.5);
-    let r2 = domain_map::optimize(target, &mut ts, source, &sl, &opts, progress)?;
-    let (s_ok, t_ok) = (r1.newton.is_some(), r2.newton.is_some());
-    let (s0_ok, t0_ok) = (r1.folded_at_start == 0, r2.folded_at_start == 0);
-    let slo = locate::locators(source, &ss.charts, &ss.state, &ss.rows, &ss.fixed);
-    let tlo = locate::locators(target, &ts.charts, &ts.state, &ts.rows, &ts.fixed);
-    // A composition is bijective only when both embeddings it passes through are injective:
-    // an optimized one (`s_ok`, `t_ok`) or an unfolded seed (`s0_ok`, `t0_ok`).
+    let n2 = if s_fold.1 == 0 { to.minimize(&mut ts, source, &sl, &opts, progress)? } else { None };
+    let r1 = DomainMapReport { newton: n1, folded_at_start: s_fold.0, folded_after_untangling: s_fold.1 };
+    let r2 = DomainMapReport { newton: n2, folded_at_start: t_fold.0, folded_after_untangling: t_fold.1 };
+    // A composition is bijective when both embeddings it passes through are injective: a
+    // minimized direction implies both untangled seeds were.
     let mut c1 = Vec::new();
-    if s_ok && t0_ok {
-        c1.push(("direct", map_through(&ss.state, &tl, target, pairs)?));
-    }
-    if t_ok && s0_ok {
-        c1.push(("inverse", map_through(&s0, &tlo, target, pairs)?));
-    }
     let mut c2 = Vec::new();
-    if t_ok && s0_ok {
-        c2.push(("direct", map_through(&ts.state, &sl, source, rev)?));
+    if n1.is_some() {
+        c1.push(("direct", map_through(&ss.state, &tl, target, pairs)?));
+        c2.push(("inverse", map_through(&t0, &locators(source, &ss), source, rev)?));
     }
-    if s_ok && t0_ok {
-        c2.push(("inverse", map_through(&t0, &slo, source, rev)?));
+    if n2.is_some() {
+        c2.push(("direct", map_through(&ts.state, &sl, source, rev)?));
+        c1.push(("inverse", map_through(&s0, &locators(target, &ts), target, pairs)?));
     }
     let mut out = maps.clone();
     let (e1, u1) = keep_lowest(source, target, &mut out.0, before[0], c1);
     let (e2, u2) = keep_lowest(target, source, &mut out.1, before[1], c2);
     let changed = u1 != "composed" || u2 != "composed";
+    tracing::debug!(?r1, ?r2, e1, e2, u1, u2, "optimized");
     Ok(Some(OptimizeReport {
         energy_before: before,
         energy_after: [e1, e2],

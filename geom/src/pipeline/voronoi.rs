@@ -284,7 +284,10 @@ fn run_with(
     let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) =
         match (optimized.as_mut().and_then(|r| r.maps.take()), contender) {
             (Some(g), _) => {
-                let decide = |cmp: RelaxedComparison| optimized.as_mut().is_some_and(|r| r.record_relaxed(cmp));
+                let decide = |cmp: RelaxedComparison| {
+                    tracing::debug!(?cmp, "composed and optimized maps after relaxation");
+                    optimized.as_mut().is_some_and(|r| r.record_relaxed(cmp))
+                };
                 pair.finish_contest(maps, g, &relax, decide, &mut clock, progress)?
             }
             (None, None) => pair.finish(maps, &relax, &mut clock, progress)?,

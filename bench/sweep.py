@@ -1,107 +1,123 @@
-"""Robustness sweep for `voronoi`/`greedy`: many shared meshes x deformations with farthest-point
-anchors, plus the registered pairs, each judged by the shared evaluator (flips both ways, area,
-L2, ground-truth error). Prints one line per case and a summary of the cases that miss a threshold.
+"""Robustness sweep on unseen cases: every closed mesh of ../shared/meshes (its README's table),
+made into a case by ../shared/tools/mkcase.py (another triangulation by edge flips, a smooth
+twist and bend, shuffled vertex order, farthest-point anchors, the true correspondence), mapped
+by each method that applies, judged by the shared evaluator. Cases are drawn from a seed that is
+printed, so any run can be repeated.
 
-Usage: python3 bench/sweep.py BINARY [METHOD] [FILTER]   (needs numpy + scipy)
+Usage: python3 bench/sweep.py SURFMAP_BINARY [--seed N] [--cases N] [--max-vertices V] [--check]
+  --cases        how many cases to draw (default 150)
+  --max-vertices only meshes up to this size (default: all)
+  --check        exit 1 on a defect: a success with flipped faces, anchors off their partners,
+                 a map off the surface, or an internal error or crash (CI runs a slice this way)
+Prints one row per case (case, mesh, genus, method, anchors, outcome, flips, gt, time) and a
+summary by outcome; "must" marks the classes that must not miss (genus 0 with >= 12 anchors,
+genus >= 1 with >= 24). Needs numpy + scipy.
 """
+import argparse
+import collections
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
+import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import table2 as t2  # noqa: E402
+HERE = os.path.dirname(os.path.abspath(__file__))
+SHARED = os.environ.get("SURFMAP_SHARED", os.path.join(HERE, "..", "..", "shared"))
+M = os.path.join(SHARED, "meshes")
+MKCASE = os.path.join(SHARED, "tools", "mkcase.py")
+sys.path.insert(0, os.path.join(SHARED, "eval"))
+import meshmetrics as mm  # noqa: E402
 
-M = t2.M
-mm = t2.mm
-
-
-def cases(tmp):
-    g0 = ["cow.off", "horse.off", "cat-low-resolution.obj", "bunny.off", "maxplanck.nf25k.off", "spot.obj",
-          "elephant.obj", "dragon.off", "homer.obj", "armadillo.obj"]
-    g1 = ["torus.obj", "knot.obj", "kitten.nf20k.off", "cow-low-resolution.obj", "rocker_arm/rocker-arm2500.off"]
-    g2 = ["eight.off", "eight_lowres.off", "cup_input_simple_10000.off", "skull_low_resolution.obj"]
-    for path in g0 + g1 + g2:
-        for kind in ["bend", "twist", "shuffle", "subdivided"]:
-            name = f"{os.path.basename(path).split('.')[0]} {kind}"
-            tag = name.replace(" ", "_")
-            yield name, lambda tag=tag, path=path, kind=kind: t2.same_shape(tmp, tag, os.path.join(M, path), kind, 24)
-    man = os.path.join(M, "registered/smpl_human/human_man.obj")
-    woman = os.path.join(M, "registered/smpl_human/human_woman.obj")
-    cat = os.path.join(M, "registered/sumner_cat_lion")
-
-    def reg(a, b, k, start):
-        V, _ = mm.load_mesh(a)
-        gt = os.path.join(tmp, "reg_gt.txt")
-        np.savetxt(gt, np.arange(len(V)), fmt="%d")
-        V = V.astype(float)
-        idx = t2.fps(np.roll(V, -start, 0), k)
-        idx = [(i + start) % len(V) for i in idx]
-        return a, b, [[i, i] for i in idx], gt
-
-    for k in [8, 12, 16, 24, 32, 45]:
-        yield f"smpl {k}", lambda k=k: reg(man, woman, k, 0)
-    for start in [100, 3000]:
-        yield f"smpl 24 start {start}", lambda s=start: reg(man, woman, 24, s)
-    for pose in ["cat-01", "cat-02", "cat-05"]:
-        yield f"cat ref/{pose}", lambda p=pose: reg(f"{cat}/cat-reference.obj", f"{cat}/{p}.obj", 24, 0)
-    yield "lion ref/lion-01", lambda: reg(f"{cat}/lion-reference.obj", f"{cat}/lion-01.obj", 24, 0)
-    mk = np.loadtxt(f"{cat}/cat_lion_markers.txt", dtype=int, usecols=(0, 1)).tolist()
-    yield "cat-01/lion-01 55", lambda: (f"{cat}/cat-01.obj", f"{cat}/lion-01.obj", mk, None)
-    yield "lion/cat 55", lambda: (f"{cat}/lion-reference.obj", f"{cat}/cat-reference.obj", [[b, a] for a, b in mk], None)
+GT_BOUND = 0.05
 
 
-def gt_map_l2(tmp, s, t, gt):
-    """L2 stretch of the ground-truth map itself (source vertex i at target vertex gt[i]): how far
-    from isometric the case's deformation is. A low-distortion map cannot follow a ground truth
-    whose own L2 stretch is high, so its ground-truth error there measures the case."""
-    VS, FS = mm.load_mesh(s)
-    VT, _ = mm.load_mesh(t)
-    p = os.path.join(tmp, "gt_map.off")
-    t2.write_off(p, VT[np.loadtxt(gt, dtype=np.int64)].astype(float), FS)
-    out = subprocess.run([sys.executable, os.path.join(os.path.dirname(M), "eval", "meshmetrics.py"), s, t, p,
-                          "--samples", "1000"], capture_output=True, text=True, check=True).stdout
-    return json.loads(out)["l2_stretch"]
+def closed_meshes():
+    """(file, vertices, genus) of every closed mesh in the shared README's table."""
+    out = []
+    for line in open(os.path.join(M, "README.md")):
+        cells = [c.strip() for c in line.split("|")]
+        if len(cells) > 8 and cells[7] == "yes" and cells[1].endswith((".off", ".obj", ".ply")):
+            if os.path.exists(os.path.join(M, cells[1])) and cells[2].isdigit():
+                out.append((cells[1], int(cells[2]), int(cells[5])))
+    return out
+
+
+def draw(rng, meshes):
+    path, nv, genus = meshes[rng.integers(len(meshes))]
+    methods = ["voronoi", "greedy"] + (["homology"] if genus >= 1 else [])
+    method = methods[rng.integers(len(methods))]
+    anchors = 1 if method == "homology" else int(rng.integers(6, 46))
+    return {"mesh": path, "vertices": nv, "genus": genus, "method": method, "anchors": anchors,
+            "mkcase_seed": int(rng.integers(1, 1 << 30)), "strength": round(float(rng.uniform(0.5, 1.0)), 3)}
+
+
+def must_not_miss(c):
+    return (c["genus"] == 0 and c["anchors"] >= 12) or (c["genus"] >= 1 and c["anchors"] >= 24)
+
+
+def run_case(binary, c, tmp):
+    d = os.path.join(tmp, "case")
+    subprocess.run([sys.executable, MKCASE, os.path.join(M, c["mesh"]), d, "--seed", str(c["mkcase_seed"]),
+                    "--anchors", str(c["anchors"]), "--strength", str(c["strength"])],
+                   check=True, capture_output=True, text=True)
+    anchors = json.load(open(os.path.join(d, "anchors.json")))["anchors"]
+    spec = os.path.join(d, "spec.json")
+    json.dump({"method": c["method"], "anchors": anchors}, open(spec, "w"))
+    out = os.path.join(d, "out")
+    t0 = time.perf_counter()
+    p = subprocess.run([binary, "map", os.path.join(d, "source.obj"), os.path.join(d, "target.obj"),
+                        "--spec", spec, "--out", out], capture_output=True, text=True)
+    r = {"time": time.perf_counter() - t0}
+    if p.returncode != 0:
+        m = re.search(r"error \[([a-z_]+)\]", p.stderr)
+        r["outcome"] = m.group(1) if m else f"crash (exit {p.returncode})"
+        r["message"] = p.stderr.strip().splitlines()[-1][:200] if p.stderr.strip() else ""
+        return r
+    S, T = mm.load_mesh(os.path.join(d, "source.obj")), mm.load_mesh(os.path.join(d, "target.obj"))
+    MP = mm.load_mesh(os.path.join(out, "source_on_target.obj"))
+    gt = T[0][np.loadtxt(os.path.join(d, "gt.txt"), dtype=np.int64)]
+    e = mm.evaluate_map(S, T, MP, anchors, gt, samples=20000)
+    rep = json.load(open(os.path.join(out, "metrics.json")))
+    r.update(flips=e["flipped_faces"] + rep["target_to_source"]["flipped_faces"], gt=e["gt_error_mean"],
+             anchor=e.get("anchor_error_max", 0.0), off=e["off_surface_max"], area=e["area_ratio"])
+    defect = r["flips"] > 0 or r["anchor"] > 1e-9 or r["off"] > 1e-6
+    r["outcome"] = "DEFECT" if defect else ("ok" if r["gt"] <= GT_BOUND else f"gt > {GT_BOUND}")
+    return r
 
 
 def main():
-    binary = sys.argv[1]
-    method = sys.argv[2] if len(sys.argv) > 2 else "voronoi"
-    filt = sys.argv[3] if len(sys.argv) > 3 else ""
-    bad = []
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("binary")
+    ap.add_argument("--seed", type=int, default=int(time.time()) % 100000)
+    ap.add_argument("--cases", type=int, default=150)
+    ap.add_argument("--max-vertices", type=int, default=1 << 40)
+    ap.add_argument("--check", action="store_true")
+    a = ap.parse_args()
+    meshes = [m for m in closed_meshes() if m[1] <= a.max_vertices]
+    print(f"seed {a.seed}, {a.cases} cases over {len(meshes)} closed meshes", flush=True)
+    rng = np.random.default_rng(a.seed)
+    counts, must_miss, defects = collections.Counter(), [], []
     with tempfile.TemporaryDirectory() as tmp:
-        for name, make in cases(tmp):
-            if filt not in name:
-                continue
-            s, t, a, gt = make()
-            e = t2.run(binary, tmp, name, s, t, a, gt, method, repeats=1)
-            if "error" in e:
-                print(f"{name:32s} ERROR {e['error']}", flush=True)
-                bad.append(name)
-                continue
-            gtm = e.get("gt_error_mean", float("nan"))
-            same_shape = gt is not None and any(k in name for k in ["bend", "twist", "shuffle", "subdivided"])
-            gt_l2 = gt_map_l2(tmp, s, t, gt) if same_shape else float("nan")
-            fb = e["report"].get("layout", {}).get("fallback")
-            g = e["report"].get("global")
-            if g and not g["used"]:
-                fb = f"{fb or ''} per-patch: {g.get('fallback')}"
-            name = f"{name} [{fb}]" if fb else name
-            line = (f"{name:32s} {e['time']:6.2f}s flips {e['flipped_faces']}/{e['rev_flips']} area {e['area_ratio']:.4f} "
-                    f"L2 {e['l2_stretch']:.4f} gt {gtm:.4f} (gt map L2 {gt_l2:.3f}) anchor {e['anchor_error_max']:.1e} off {e['off_surface_max']:.1e}"
-                    + (f" E0 {e['report']['smoothing']['energy_before']:.3f} G {e['report'].get('global')}" if os.environ.get("SWEEP_ENERGY") else ""))
-            miss = e["flipped_faces"] or e["rev_flips"] or not 0.97 <= e["area_ratio"] <= 1.03 or \
-                e["anchor_error_max"] > 1e-9 or e["off_surface_max"] > 1e-6
-            # Same-shape cases (24 anchors): the ground-truth error and L2 bounds as well.
-            if same_shape:
-                miss = miss or gtm > 0.02 or e["l2_stretch"] > 1.15
-            if miss:
-                bad.append(name)
-            print(line + ("   <-- MISS" if miss else ""), flush=True)
-    print(json.dumps({"missed": bad}))
+        for i in range(a.cases):
+            c = draw(rng, meshes)
+            r = run_case(a.binary, c, tmp)
+            counts[r["outcome"]] += 1
+            must = must_not_miss(c)
+            if must and r["outcome"] != "ok":
+                must_miss.append(i)
+            if r["outcome"] == "DEFECT" or r["outcome"] in ("internal",) or r["outcome"].startswith("crash"):
+                defects.append(i)
+            figures = (f"flips {r['flips']} gt {r['gt']:.4f} area {r['area']:.3f}" if "gt" in r
+                       else r.get("message", ""))
+            print(f"{i:3d} {c['mesh']:30s} g{c['genus']} {c['method']:8s} {c['anchors']:2d} "
+                  f"{'must' if must else '    '} {r['outcome']:18s} {r['time']:6.2f}s  {figures}", flush=True)
+    print(json.dumps({"seed": a.seed, "outcomes": counts, "must_not_miss_missed": must_miss, "defects": defects}))
+    if a.check and defects:
+        sys.exit(1)
 
 
 if __name__ == "__main__":

@@ -6,15 +6,15 @@
 //! the other mesh's seed. An optimized direction also yields the other as its inverse: the
 //! other mesh's seed located among the optimized images. Per direction the candidate of lower
 //! energy replaces the composed map when it is lower in energy than the composed map; both
-//! pairs are then relaxed and the optimized one kept when it folds no more and stretches less
-//! (the energy before relaxation does not see what the repairs will leave).
+//! are then relaxed and, per direction, the optimized one kept when it folds less, or as much
+//! and stretches less (the energy before relaxation does not see what the repairs leave).
 //!
 //! It runs only where the composed maps are far from isometric (normalized energy above
 //! [`GATE`], seen: plane → bird 2.8 / 3.0), not on same-shape pairs or SMPL man → woman
 //! (1.7–2.0), where the relaxation alone does as well and the optimized maps lost the contest
 //! after seconds of work (figures in `bench/NOTES.md`).
 
-use super::global_choice::{GlobalInputs, RelaxedComparison, domain_lengths};
+use super::global_choice::{GlobalInputs, RELAXED_AREA_SLACK, domain_lengths};
 use crate::crossparam::global::domain_map::{DomainMapReport, DomainOptimizer};
 use crate::crossparam::global::{Seed, locate, map_through, seed};
 use crate::crossparam::smooth::SourceFrame;
@@ -47,24 +47,28 @@ pub struct OptimizeReport {
     pub used: [&'static str; 2],
     pub source: DomainMapReport,
     pub target: DomainMapReport,
-    /// Composed and optimized maps after relaxation, both directions summed (L2 stretch,
-    /// folded faces, |area ratio − 1|), when any direction changed; the optimized ones are
-    /// kept when they fold no more and stretch less.
+    /// Per direction, the composed and the optimized map after relaxation (L2 stretch, folded
+    /// faces, |area ratio − 1|), when any direction changed; the optimized one is kept when it
+    /// folds less, or as much and stretches less without losing area (`kept`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub relaxed: Option<RelaxedComparison>,
-    /// Whether the optimized maps were kept after relaxation.
-    pub kept: bool,
+    pub relaxed: Option<[[Quality; 2]; 2]>,
+    pub kept: [bool; 2],
     /// The optimized maps (per direction the composed one where it stayed lower), until the
     /// relaxation takes them.
     #[serde(skip)]
     pub maps: Option<(SurfaceMap, SurfaceMap)>,
 }
 
+/// A relaxed map's L2 stretch, folded faces and |area ratio − 1|.
+pub type Quality = (f64, usize, f64);
+
 impl OptimizeReport {
-    /// Records the comparison after relaxation; returns whether the optimized maps are kept.
-    pub(super) fn record_relaxed(&mut self, cmp: RelaxedComparison) -> bool {
-        self.relaxed = Some(cmp);
-        self.kept = cmp.prefers_global();
+    /// Records the per-direction comparison after relaxation (composed `p`, optimized `g`);
+    /// returns per direction whether the optimized map is kept.
+    pub(super) fn record_relaxed(&mut self, p: [Quality; 2], g: [Quality; 2]) -> [bool; 2] {
+        let better = |p: Quality, g: Quality| g.1 < p.1 || (g.1 == p.1 && g.0 < p.0 && g.2 <= p.2 + RELAXED_AREA_SLACK);
+        self.relaxed = Some([[p[0], g[0]], [p[1], g[1]]]);
+        self.kept = [better(p[0], g[0]), better(p[1], g[1])];
         self.kept
     }
 }
@@ -152,7 +156,7 @@ pub(super) fn optimize_maps(
         source: r1,
         target: r2,
         relaxed: None,
-        kept: false,
+        kept: [false; 2],
         maps: changed.then_some(out),
     }))
 }

@@ -5,9 +5,10 @@
 use super::common::relax::{Direction, finish_direction, measure_direction, relax_direction};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
 use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
-use super::optimize::{self, OptimizeReport};
+use super::optimize::{self, OptimizeReport, Quality};
 use super::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
 use crate::crossparam::global::GlobalParamOptions;
+use crate::crossparam::smooth::SmoothReport;
 use crate::crossparam::{compose, parameterize_patches};
 use crate::domain::refine::refine;
 use crate::domain::tracer::Tracer;
@@ -151,39 +152,34 @@ impl Pair<'_> {
         Ok((a?, b?))
     }
 
-    /// Relaxes both the per-patch maps `p` and the global maps `g` in each direction, keeps the
-    /// better pair (recorded in `report`) and measures it.
-    fn finish_contest(
+    /// Relaxes a pair of maps (source → target, target → source), the target direction on a
+    /// side thread.
+    fn relax_pair(
         &self,
-        p: (SurfaceMap, SurfaceMap),
-        g: (SurfaceMap, SurfaceMap),
+        (s2t, t2s): (SurfaceMap, SurfaceMap),
         o: &RelaxOptions,
-        decide: impl FnOnce(RelaxedComparison) -> bool,
-        clock: &mut Clock,
+        progress: &mut dyn Progress,
+    ) -> Result<Relaxed> {
+        let mut side = progress.silent();
+        let (a, b) = both(
+            || relax_direction(self.target, self.source, t2s, self.ta, o, &mut side),
+            || relax_direction(self.source, self.target, s2t, self.sa, o, progress),
+        )?;
+        Ok((a?, b?))
+    }
+
+    /// Relaxed L2 stretch, folds and area deviation of both directions.
+    fn qualities(&self, r: &Relaxed) -> Result<[Quality; 2]> {
+        Ok([relaxed_quality(self.source, self.target, &r.0.0)?, relaxed_quality(self.target, self.source, &r.1.0)?])
+    }
+
+    /// Measures a relaxed pair, the target direction on a side thread.
+    fn measure_pair(
+        &self,
+        ((s2t, r1), (t2s, r2)): Relaxed,
+        o: &RelaxOptions,
         progress: &mut dyn Progress,
     ) -> Result<(Direction, Direction)> {
-        let relax_both = |from: &Mesh,
-                          to: &Mesh,
-                          p: SurfaceMap,
-                          g: SurfaceMap,
-                          fixed: &[VertexId],
-                          progress: &mut dyn Progress|
-         -> Result<_> {
-            let p = relax_direction(from, to, p, fixed, o, progress)?;
-            let g = relax_direction(from, to, g, fixed, o, progress)?;
-            let (qp, qg) = (relaxed_quality(from, to, &p.0)?, relaxed_quality(from, to, &g.0)?);
-            Ok((p, g, qp, qg))
-        };
-        let mut side = progress.silent();
-        let (x, y) = both(
-            || relax_both(self.target, self.source, p.1, g.1, self.ta, &mut side),
-            || relax_both(self.source, self.target, p.0, g.0, self.sa, progress),
-        )?;
-        let ((ps, gs, qps, qgs), (pt, gt, qpt, qgt)) = (x?, y?);
-        clock.lap("smooth");
-        let cmp = RelaxedComparison::new([qps, qpt], [qgs, qgt]);
-        let use_global = decide(cmp);
-        let ((s2t, r1), (t2s, r2)) = if use_global { (gs, gt) } else { (ps, pt) };
         let measure = |from: &Mesh,
                        to: &Mesh,
                        m: SurfaceMap,
@@ -194,6 +190,7 @@ impl Pair<'_> {
             let (e, met) = measure_direction(from, to, &m, anchors, o, progress)?;
             Ok((m, r, e, met))
         };
+        let mut side = progress.silent();
         let (a, b) = both(
             || measure(self.target, self.source, t2s, r2, self.rev, &mut side),
             || measure(self.source, self.target, s2t, r1, self.pairs, progress),
@@ -201,6 +198,9 @@ impl Pair<'_> {
         Ok((a?, b?))
     }
 }
+
+/// Both directions relaxed: each map and what relaxing it did.
+type Relaxed = ((SurfaceMap, SmoothReport), (SurfaceMap, SmoothReport));
 
 /// Runs a `voronoi` or `greedy` job.
 ///
@@ -283,18 +283,26 @@ fn run_with(
     let mut optimized = optimized.map(Box::new);
     let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) =
         match (optimized.as_mut().and_then(|r| r.maps.take()), contender) {
-            (Some(g), _) => {
-                let decide = |cmp: RelaxedComparison| {
-                    tracing::debug!(?cmp, "composed and optimized maps after relaxation");
-                    optimized.as_mut().is_some_and(|r| r.record_relaxed(cmp))
-                };
-                pair.finish_contest(maps, g, &relax, decide, &mut clock, progress)?
-            }
             (None, None) => pair.finish(maps, &relax, &mut clock, progress)?,
-            (None, Some(g)) => {
-                let decide =
-                    |cmp: RelaxedComparison| global.as_mut().map_or(cmp.prefers_global(), |r| r.record_relaxed(cmp));
-                pair.finish_contest(maps, g, &relax, decide, &mut clock, progress)?
+            (candidate, contender) => {
+                let mut chosen = pair.relax_pair(maps, &relax, progress)?;
+                // The per-patch composition against the global one, as a pair.
+                if let Some(g) = contender {
+                    let other = pair.relax_pair(g, &relax, progress)?;
+                    let cmp = RelaxedComparison::new(pair.qualities(&chosen)?, pair.qualities(&other)?);
+                    if global.as_mut().map_or(cmp.prefers_global(), |r| r.record_relaxed(cmp)) {
+                        chosen = other;
+                    }
+                }
+                // The optimized maps against the winner, per direction.
+                if let (Some(m), Some(r)) = (candidate, optimized.as_mut()) {
+                    let other = pair.relax_pair(m, &relax, progress)?;
+                    let keep = r.record_relaxed(pair.qualities(&chosen)?, pair.qualities(&other)?);
+                    let ((c0, c1), (o0, o1)) = (chosen, other);
+                    chosen = (if keep[0] { o0 } else { c0 }, if keep[1] { o1 } else { c1 });
+                }
+                clock.lap("smooth");
+                pair.measure_pair(chosen, &relax, progress)?
             }
         };
     clock.lap("metrics");

@@ -128,7 +128,8 @@ pub(super) fn evaluator_flips_in_star(
 
 /// The evaluator's flip rule for one mapped triangle `m` whose corners lie on target faces
 /// `under`: its normal opposes the target's at those three faces and at the face nearest to its
-/// centroid (queried last, only when the corners agree).
+/// centroid (queried last, only when the corners agree), a point on an edge or corner counting
+/// as opposed when any face there opposes (ties the evaluator may break otherwise).
 pub(crate) fn evaluator_folded(
     m: [P3; 3],
     under: [crate::FaceId; 3],
@@ -136,8 +137,14 @@ pub(crate) fn evaluator_folded(
     index: &SurfaceIndex,
 ) -> bool {
     let nm = (m[1] - m[0]).cross(&(m[2] - m[0]));
-    under.iter().all(|g| nm.dot(&tn[g.idx()]) < 0.0)
-        && nm.dot(&tn[index.query(&crate::metrics::face_centroid(m)).face.idx()]) < 0.0
+    let opposes = |g: &crate::FaceId| nm.dot(&tn[g.idx()]) < 0.0;
+    // A point on an edge or corner of its face opposes when any face around it does: the
+    // evaluator may break that tie the other way, so such a face is repaired as folded.
+    let at = |g: crate::FaceId, p: &P3| opposes(&g) || index.tied_faces(g, p).iter().any(opposes);
+    under.iter().zip(&m).all(|(g, p)| at(*g, p)) && {
+        let c = index.query(&crate::metrics::face_centroid(m));
+        at(c.face, &c.point)
+    }
 }
 
 /// Faces of `map: source -> target` that the evaluator counts as flipped (screened by

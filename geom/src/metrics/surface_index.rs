@@ -210,6 +210,35 @@ impl<'m> SurfaceIndex<'m> {
 
     /// [`SurfaceIndex::query`] for every point (face and point included, ties resolved in the
     /// candidates' distance order as the evaluator does), visited in Morton order.
+    /// `f`, and when `p` (a point of `f`) lies on one of its edges or at a corner (barycentric
+    /// weight within 1e-9 of 0), the other faces around that edge or corner: the faces another
+    /// tie-break (the evaluator's, in floating point) may take as nearest to `p`.
+    pub fn tied_faces(&self, f: FaceId, p: &P3) -> Vec<FaceId> {
+        let ([a, b, c], ids) = (self.mesh.face_points(f), self.mesh.face(f));
+        let n = (b - a).cross(&(c - a));
+        let nn = n.norm_squared();
+        if nn == 0.0 || !nn.is_finite() {
+            return vec![f];
+        }
+        let w = [
+            (c - b).cross(&(p - b)).dot(&n) / nn,
+            (a - c).cross(&(p - c)).dot(&n) / nn,
+            (b - a).cross(&(p - a)).dot(&n) / nn,
+        ];
+        let zero: Vec<usize> = (0..3).filter(|&k| w[k].abs() <= 1e-9).collect();
+        match zero.as_slice() {
+            [] => vec![f],
+            &[k] => {
+                let (u, v) = (ids[(k + 1) % 3], ids[(k + 2) % 3]);
+                self.mesh.vertex_faces(u).filter(|&g| self.mesh.face(g).contains(&v)).collect()
+            }
+            _ => {
+                let k = (0..3).find(|k| !zero.contains(k)).unwrap_or(0);
+                self.mesh.vertex_faces(ids[k]).collect()
+            }
+        }
+    }
+
     pub fn query_all(&self, pts: &[P3]) -> Vec<Nearest> {
         let mut out = vec![Nearest { distance: f64::INFINITY, face: FaceId(0), point: P3::origin() }; pts.len()];
         for (i, n) in self.search_chunks(pts, &super::distance::morton_order(pts), true) {
@@ -390,6 +419,28 @@ impl<'m> SurfaceIndex<'m> {
 mod tests {
     use super::*;
     use crate::mesh::shapes;
+
+    /// A point inside a face ties with nothing; on an edge with the face across it; at a corner
+    /// with every face around that vertex.
+    #[test]
+    fn tied_faces_are_the_faces_around_an_edge_or_corner() {
+        let m = shapes::icosphere(2);
+        let index = SurfaceIndex::new(&m).unwrap();
+        let f = FaceId(7);
+        let [a, b, c] = m.face_points(f);
+        let inside = P3::from((a.coords + b.coords + c.coords) / 3.0);
+        assert_eq!(index.tied_faces(f, &inside), vec![f]);
+        let on_edge = P3::from((a.coords + b.coords) / 2.0);
+        let mut t = index.tied_faces(f, &on_edge);
+        t.sort();
+        let [u, v, _] = m.face(f);
+        let mut want: Vec<FaceId> = m.vertex_faces(u).filter(|&g| m.face(g).contains(&v)).collect();
+        want.sort();
+        assert_eq!((t.len(), t), (2, want));
+        let at_corner = index.tied_faces(f, &a);
+        assert_eq!(at_corner.len(), m.vertex_faces(u).count());
+        assert!(at_corner.contains(&f));
+    }
 
     #[test]
     fn closest_point_regions() {

@@ -208,8 +208,6 @@ impl<'m> SurfaceIndex<'m> {
         self.distances_in_order(pts, &super::distance::morton_order(pts))
     }
 
-    /// [`SurfaceIndex::query`] for every point (face and point included, ties resolved in the
-    /// candidates' distance order as the evaluator does), visited in Morton order.
     /// `f`, and when `p` (a point of `f`) lies on one of its edges or at a corner (barycentric
     /// weight within 1e-9 of 0), the other faces around that edge or corner: the faces another
     /// tie-break (the evaluator's, in floating point) may take as nearest to `p`.
@@ -239,6 +237,8 @@ impl<'m> SurfaceIndex<'m> {
         }
     }
 
+    /// [`SurfaceIndex::query`] for every point (face and point included, ties resolved in the
+    /// candidates' distance order as the evaluator does), visited in Morton order.
     pub fn query_all(&self, pts: &[P3]) -> Vec<Nearest> {
         let mut out = vec![Nearest { distance: f64::INFINITY, face: FaceId(0), point: P3::origin() }; pts.len()];
         for (i, n) in self.search_chunks(pts, &super::distance::morton_order(pts), true) {

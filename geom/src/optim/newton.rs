@@ -223,18 +223,11 @@ impl InjectiveNewton {
         // No vertex moves farther than a typical edge in one step: a long jump across chart
         // sides can land a vertex on another sheet around a cone, a fold no step undoes.
         let longest = dir.iter().map(|q| q[0].hypot(q[1])).fold(0.0, f64::max);
-        let mut t = if longest > 0.0 { (self.typical_edge(d, s) / longest).min(1.0) } else { 1.0 };
-        while t > 1e-12 {
-            let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
-            if let Some(trial) = d.moved(s, &step)
-                && let Some(e) = self.energy_eps(d, &trial, metrics, eps)
-                && e <= energy + 1e-4 * t * slope
-            {
-                return Some((trial, e));
-            }
-            t *= 0.5;
-        }
-        None
+        let t = if longest > 0.0 { (self.typical_edge(d, s) / longest).min(1.0) } else { 1.0 };
+        backtrack(d, s, dir, t, |trial, t| {
+            self.energy_eps(d, trial, metrics, eps).filter(|&e| e <= energy + 1e-4 * t * slope)
+        })
+        .map(|(trial, e, _)| (trial, e))
     }
 
     /// The median edge length of the triangles in their charts.
@@ -402,26 +395,40 @@ impl InjectiveNewton {
         if *slope >= 0.0 {
             return None;
         }
-        let mut t = (opts.step_fraction * self.first_inversion(d, s, dir)).min(1.0);
-        let mut backtracks = 0;
-        while t > 1e-12 {
-            let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
-            // The frozen metrics give the direction and the Armijo test; the step must also
-            // lower the energy under the metrics where the trial lands (a long step crosses
-            // many target faces, and the frozen energy alone let it wander uphill).
-            if let Some(trial) = d.moved(s, &step)
-                && self.energy_with(d, &trial, metrics).is_some_and(|e| e <= energy + 1e-4 * t * slope)
-                && let Some(e) = self.energy(d, &trial)
-                && e < energy
-                && self.is_injective(d, &trial)
-            {
-                return Some((trial, e, backtracks));
+        let t = (opts.step_fraction * self.first_inversion(d, s, dir)).min(1.0);
+        // The frozen metrics give the direction and the Armijo test; the step must also lower
+        // the energy under the metrics where the trial lands (a long step crosses many target
+        // faces, and the frozen energy alone let it wander uphill).
+        backtrack(d, s, dir, t, |trial, t| {
+            if !self.energy_with(d, trial, metrics).is_some_and(|e| e <= energy + 1e-4 * t * slope) {
+                return None;
             }
-            backtracks += 1;
-            t *= 0.5;
-        }
-        None
+            self.energy(d, trial).filter(|&e| e < energy && self.is_injective(d, trial))
+        })
     }
+}
+
+/// Halves the step `t` along `dir` from its start until `accept` gives the trial an energy;
+/// returns the trial, that energy and the refused trials.
+fn backtrack<D: MapDomain>(
+    d: &D,
+    s: &D::State,
+    dir: &[Uv],
+    mut t: f64,
+    accept: impl Fn(&D::State, f64) -> Option<f64>,
+) -> Option<(D::State, f64, usize)> {
+    let mut refused = 0;
+    while t > 1e-12 {
+        let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
+        if let Some(trial) = d.moved(s, &step)
+            && let Some(e) = accept(&trial, t)
+        {
+            return Some((trial, e, refused));
+        }
+        refused += 1;
+        t *= 0.5;
+    }
+    None
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! its meta-mesh pair, which is fold-free by construction, succeeds with the folded direction's
 //! vertex-map artifacts withheld (listed in the report's `withheld`).
 
-use super::common::{Artifact, PairReport, json_artifact};
+use super::common::{Artifact, json_artifact};
 use super::{JobReport, JobSpec};
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, VertexId};
@@ -53,7 +53,7 @@ pub(super) fn refuse_folds(
         JobReport::Features(r) => r.features.meta_mesh.as_ref().is_some_and(|m| m.error.is_none()),
         _ => false,
     };
-    let Some(pair) = pair_mut(report) else { return Ok(()) };
+    let Some(pair) = report.pair_mut() else { return Ok(()) };
     let counts = [pair.source_to_target.flipped_faces, pair.target_to_source.flipped_faces];
     if counts == [0, 0] {
         return Ok(());
@@ -89,15 +89,6 @@ pub(super) fn refuse_folds(
         .collect::<Vec<_>>()
         .join("; ");
     Err(Error::MapFolds { flipped: counts[0] + counts[1], detail: format!("{where_}. {}", remedies(spec)) })
-}
-
-fn pair_mut(report: &mut JobReport) -> Option<&mut PairReport> {
-    match report {
-        JobReport::Layout(r) => Some(&mut r.pair),
-        JobReport::Homology(r) => Some(&mut r.pair),
-        JobReport::Features(r) => Some(&mut r.pair),
-        JobReport::Quad(_) => None,
-    }
 }
 
 fn spec_anchors(spec: &JobSpec) -> Vec<[u64; 2]> {

@@ -56,6 +56,16 @@ impl JobReport {
         }
     }
 
+    /// [`JobReport::pair`], mutably.
+    pub fn pair_mut(&mut self) -> Option<&mut PairReport> {
+        match self {
+            JobReport::Layout(r) => Some(&mut r.pair),
+            JobReport::Homology(r) => Some(&mut r.pair),
+            JobReport::Features(r) => Some(&mut r.pair),
+            JobReport::Quad(_) => None,
+        }
+    }
+
     /// Milliseconds per stage.
     pub fn timings_ms(&self) -> &[(String, f64)] {
         match self {

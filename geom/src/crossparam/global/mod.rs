@@ -107,18 +107,12 @@ pub fn global_param(
     let seed = seed(mesh, patches, anchors, init, refined, lengths)?;
     let Seed { charts, mut state, fixed, rows } = seed;
     let st = &mut state;
-    let debug = tracing::enabled!(tracing::Level::DEBUG);
     let mut system = solve::System::new(&fixed);
     let residual = relax(&charts, &mut system, st, &fixed, &rows, opts.max_solves)?;
     progress.check()?;
     let l2 = vertex_stretch(mesh, st, &rows, &fixed);
-    if debug {
-        tracing::debug!(
-            "global: harmonic map: folds {} l2 {l2} residual {residual:.2e}",
-            flipped(mesh, st, &rows, &fixed)
-        );
-    }
     let flipped = flipped(mesh, st, &rows, &fixed);
+    tracing::debug!("global: harmonic map: folds {flipped} l2 {l2} residual {residual:.2e}");
     let locators = locate::locators(mesh, &charts, st, &rows, &fixed);
     Ok(GlobalParam { charts, state, locators, flipped, l2, residual })
 }

@@ -103,6 +103,9 @@ pub enum InputError {
         "the job needs an estimated {estimate_mib} MiB, above the budget of {budget_mib} MiB per job: use smaller meshes or options"
     )]
     OverBudget { estimate_mib: u64, budget_mib: u64 },
+    /// A file requires an extension this service does not implement (named).
+    #[error("the file requires the extension {0}, which surfmap does not read (export without it)")]
+    UnsupportedExtension(String),
 }
 
 impl InputError {
@@ -134,6 +137,7 @@ impl InputError {
             InputError::LayoutConflict(_) => "layout_conflict",
             InputError::OptionRange(_) => "option_out_of_range",
             InputError::OverBudget { .. } => "over_budget",
+            InputError::UnsupportedExtension(_) => "unsupported_extension",
         }
     }
 }

@@ -38,6 +38,9 @@ fn seeds() -> &'static Vec<(Format, Vec<u8>)> {
         }
         stl.push_str("endsolid s\n");
         v.push((Format::Stl, stl.into_bytes()));
+        // glTF: a GLB of a mesh with seams and attributes (spot), and the small mesh's GLB.
+        v.push((Format::Gltf, std::fs::read(common::shared_mesh("spot.obj")).map(|b| common::glb_of_obj(&b)).unwrap()));
+        v.push((Format::Gltf, io::write(&small, Format::Gltf)));
         v
     })
 }

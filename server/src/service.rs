@@ -93,10 +93,11 @@ fn parse_format(hint: Option<&str>) -> Result<Option<Format>, ApiError> {
         Some("off") => Some(Format::Off),
         Some("ply") => Some(Format::Ply),
         Some("stl") => Some(Format::Stl),
+        Some("gltf" | "glb") => Some(Format::Gltf),
         Some(other) => {
             return Err(ApiError::bad_request(
                 "unknown_format",
-                format!("format {other:?} is not obj, off, ply or stl"),
+                format!("format {other:?} is not obj, off, ply, stl, gltf or glb"),
             ));
         }
     })

@@ -1,22 +1,30 @@
-//! Mesh files: format detection from content, readers (OBJ, OFF, PLY, STL) and writers.
+//! Mesh files: format detection from content, readers (OBJ, OFF, PLY, STL, glTF) and writers.
 //! This is the only module of the crate that touches bytes or files.
+//!
+//! Formats that split vertices at attribute seams (glTF; OBJ whose corners use several `vt` or
+//! `vn` per position) are welded for the topology: [`ReadResult::layout`] keeps the input's own
+//! vertices, triangles and attributes (see [`crate::mesh::layout`]).
 
-mod gltf;
+mod glb_write;
+mod gltf_accessor;
+mod gltf_prims;
+mod gltf_read;
 mod lex;
 mod obj;
+mod obj_seams;
 mod off;
 mod ply;
 mod ply_binary;
 mod png16;
 mod stl;
 
-pub use gltf::write_glb;
+pub use glb_write::{GlbMesh, write_glb, write_glb_mesh, write_layout_glb};
 pub use obj::write_uv_patches as write_obj_uv_patches;
 pub use ply::write_with_face_ints as write_ply_with_face_ints;
 pub use png16::{read_rgb16, write_rgb16};
 
 use crate::error::{InputError, Result};
-use crate::mesh::{Mesh, MeshLimits, RawMesh, Warning};
+use crate::mesh::{InputLayout, Mesh, MeshLimits, RawMesh, Warning, layout};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -28,6 +36,8 @@ pub enum Format {
     Off,
     Ply,
     Stl,
+    /// glTF 2.0: `.glb`, or `.gltf` JSON with embedded buffers.
+    Gltf,
 }
 
 impl Format {
@@ -39,6 +49,7 @@ impl Format {
             "off" => Format::Off,
             "ply" => Format::Ply,
             "stl" => Format::Stl,
+            "glb" | "gltf" => Format::Gltf,
             _ => return None,
         })
     }
@@ -49,6 +60,7 @@ impl Format {
             Format::Off => "off",
             Format::Ply => "ply",
             Format::Stl => "stl",
+            Format::Gltf => "gltf",
         }
     }
 }
@@ -80,6 +92,9 @@ pub fn detect(b: &[u8], hint: Option<Format>) -> Result<Format> {
     if b.iter().all(|c| c.is_ascii_whitespace()) {
         return Err(InputError::Empty("the file is empty".into()).into());
     }
+    if gltf_read::sniff(b) {
+        return Ok(Format::Gltf);
+    }
     if ply::sniff(b) {
         return Ok(Format::Ply);
     }
@@ -95,33 +110,43 @@ pub fn detect(b: &[u8], hint: Option<Format>) -> Result<Format> {
     match hint {
         Some(f) => Ok(f),
         None => Err(InputError::UnknownFormat(
-            "content is not PLY, STL, OFF or OBJ (first bytes: ".to_string() + &lex::show(&b[..b.len().min(16)]) + ")",
+            "content is not glTF, PLY, STL, OFF or OBJ (first bytes: ".to_string()
+                + &lex::show(&b[..b.len().min(16)])
+                + ")",
         )
         .into()),
     }
 }
 
-/// Parses bytes into a raw (unvalidated) mesh.
+/// Parses bytes into a raw (unvalidated) mesh, welded, with the input's own layout when the
+/// format split vertices at seams.
 ///
 /// # Errors
 /// An [`InputError`] with the position of the problem.
-pub fn read_raw(b: &[u8], opts: &ReadOptions) -> Result<(Format, RawMesh)> {
+pub fn read_raw(b: &[u8], opts: &ReadOptions) -> Result<(Format, RawMesh, Option<InputLayout>)> {
     let fmt = detect(b, opts.hint)?;
-    let raw = match fmt {
+    let (raw, lay) = match fmt {
         Format::Obj => obj::read(b, opts)?,
-        Format::Off => off::read(b, opts)?,
-        Format::Ply => ply::read(b, opts)?,
-        Format::Stl => stl::read(b, opts)?,
+        Format::Off => (off::read(b, opts)?, None),
+        Format::Ply => (ply::read(b, opts)?, None),
+        Format::Stl => (stl::read(b, opts)?, None),
+        Format::Gltf => {
+            let (raw, lay) = layout::weld(gltf_read::read(b, opts)?)?;
+            (raw, Some(lay))
+        }
     };
-    Ok((fmt, raw))
+    Ok((fmt, raw, lay))
 }
 
 /// A mesh read from bytes, with its detected format and warnings.
 #[derive(Debug, Clone)]
 pub struct ReadResult {
+    /// The welded mesh the mapping runs on.
     pub mesh: Mesh,
     pub format: Format,
     pub warnings: Vec<Warning>,
+    /// The input's own vertices when they differ from the mesh's (seams), with its attributes.
+    pub layout: Option<InputLayout>,
 }
 
 /// Reads and validates a mesh from bytes.
@@ -129,9 +154,18 @@ pub struct ReadResult {
 /// # Errors
 /// Any [`InputError`] of parsing or of [`Mesh::from_raw`].
 pub fn read(b: &[u8], opts: &ReadOptions) -> Result<ReadResult> {
-    let (format, raw) = read_raw(b, opts)?;
-    let (mesh, warnings) = Mesh::from_raw(raw)?;
-    Ok(ReadResult { mesh, format, warnings })
+    let (format, raw, layout) = read_raw(b, opts)?;
+    let n_raw = raw.positions.len();
+    let (mesh, mut warnings) = Mesh::from_raw(raw)?;
+    // Only an OBJ with unused `v` lines is renumbered; its seams are then not kept.
+    let layout = match layout {
+        Some(_) if mesh.n_vertices() != n_raw => {
+            warnings.push(Warning::new("uv_seams", "seams not kept: the file has unused vertices"));
+            None
+        }
+        l => l,
+    };
+    Ok(ReadResult { mesh, format, warnings, layout })
 }
 
 /// Reads a mesh file; the extension is a hint only.
@@ -152,8 +186,13 @@ pub fn write(mesh: &Mesh, format: Format) -> Vec<u8> {
         Format::Off => off::write(mesh, &mut out),
         Format::Ply => ply::write(mesh, &mut out),
         Format::Stl => stl::write(mesh, &mut out),
+        Format::Gltf => out = write_glb(mesh.positions(), &faces_u32(mesh), &[]),
     }
     out
+}
+
+fn faces_u32(mesh: &Mesh) -> Vec<[u32; 3]> {
+    mesh.faces().iter().map(|f| f.map(|v| v.0)).collect()
 }
 
 /// Writes a mesh file in the format of its extension.

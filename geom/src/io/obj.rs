@@ -7,9 +7,11 @@
 //! Per-corner `vt`/`vn` become per-vertex attributes when each vertex uses one of each.
 
 use super::lex::{Lex, parse_f64, parse_i64, show};
+use super::obj_seams::Corners;
 use super::{ReadOptions, check_limits};
 use crate::error::{InputError, Result};
-use crate::mesh::{Mesh, RawMesh, V3, Warning};
+use crate::mesh::layout::VertexIds;
+use crate::mesh::{InputLayout, Mesh, RawMesh, V3, Warning};
 
 /// Cheap content check: a text file whose statements are OBJ keywords.
 pub(crate) fn sniff(b: &[u8]) -> bool {
@@ -46,7 +48,10 @@ fn resolve(lx: &Lex, t: &[u8], count: usize, what: &str) -> Result<u32> {
 const NONE: u32 = u32::MAX;
 
 /// Reads an OBJ file.
-pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
+///
+/// When the corners of a vertex use different `vt` or `vn` (seams) and every face is a
+/// triangle, the input's own layout comes back too: one input vertex per `(v, vt, vn)`.
+pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<(RawMesh, Option<InputLayout>)> {
     let mut lx = Lex::new(b, "OBJ");
     let mut positions: Vec<[f64; 3]> = Vec::new();
     let mut colors: Vec<[u8; 4]> = Vec::new();
@@ -168,6 +173,22 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
     }
     raw.attributes.uvs = per_vertex(&raw, &corner_vt, &vts, "texture coordinates");
     raw.attributes.normals = per_vertex(&raw, &corner_vn, &vns, "normals");
+    let seams =
+        (!vts.is_empty() && raw.attributes.uvs.is_none()) || (!vns.is_empty() && raw.attributes.normals.is_none());
+    if seams && all_tri && corner_vt.len() == raw.indices.len() && corner_vn.len() == raw.indices.len() {
+        let c = Corners {
+            positions: &raw.positions,
+            indices: &raw.indices,
+            vt: &corner_vt,
+            vts: &vts,
+            vn: &corner_vn,
+            vns: &vns,
+        };
+        let (welded, split) = c.split();
+        let layout =
+            InputLayout { welded, triangles: split.triangles, attributes: split.attributes, ids: VertexIds::Welded };
+        return Ok((raw, Some(layout)));
+    }
     if !vts.is_empty() && raw.attributes.uvs.is_none() {
         raw.warnings
             .push(Warning::new("uv_seams", "texture coordinates differ per corner (seams); not kept per vertex"));
@@ -175,7 +196,7 @@ pub(crate) fn read(b: &[u8], opts: &ReadOptions) -> Result<RawMesh> {
     if !vns.is_empty() && raw.attributes.normals.is_none() {
         raw.warnings.push(Warning::new("normal_seams", "normals differ per corner; not kept per vertex"));
     }
-    Ok(raw)
+    Ok((raw, None))
 }
 
 /// Turns per-corner attribute indices into per-vertex values when they are consistent.

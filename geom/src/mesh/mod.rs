@@ -10,12 +10,14 @@ mod build;
 pub mod cut;
 mod cut_copy;
 mod ids;
+pub mod layout;
 pub mod refine;
 pub mod shapes;
 mod triangulate;
 
 pub use build::{MeshLimits, RawMesh, Warning};
 pub use ids::{EdgeId, ElementData, FaceData, FaceId, HalfedgeId, VertexData, VertexId};
+pub use layout::{Attributes, InputLayout, SplitMesh};
 pub use triangulate::triangulate_polygon;
 
 use nalgebra::{Point3, Vector3};

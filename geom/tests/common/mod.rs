@@ -210,3 +210,9 @@ pub fn meta_pair(arts: &[geom::pipeline::Artifact], s: &Mesh, t: &Mesh, what: &s
     }
     (ms, mt)
 }
+
+/// A GLB of an OBJ file in its own (seam-split) layout with its attributes.
+pub fn glb_of_obj(obj: &[u8]) -> Vec<u8> {
+    let r = geom::io::read(obj, &ReadOptions::default()).expect("read obj");
+    geom::io::write_layout_glb(&r.mesh, r.layout.as_ref(), &[])
+}

@@ -23,9 +23,12 @@ pub fn inspect(path: &Path) -> Result<String> {
     v["format"] = json!(r.format);
     v["warnings"] = serde_json::to_value(&r.warnings).map_err(|e| Error::Internal(e.to_string()))?;
     let a = r.mesh.attributes();
-    v["attributes"] = json!({
-        "normals": a.normals.is_some(), "colors": a.colors.is_some(), "uvs": a.uvs.is_some()
-    });
+    v["attributes"] = match &r.layout {
+        Some(l) => json!({
+            "names": l.attributes.names(), "input_vertices": l.n_vertices(), "seam_copies": l.n_split()
+        }),
+        None => json!({"normals": a.normals.is_some(), "colors": a.colors.is_some(), "uvs": a.uvs.is_some()}),
+    };
     serde_json::to_string_pretty(&v).map_err(|e| Error::Internal(e.to_string()))
 }
 
@@ -38,7 +41,7 @@ pub fn convert(
     kept: Option<&Path>,
 ) -> Result<String> {
     let r = read(input)?;
-    let mut mesh = if subdivide > 0 { geom::mesh::shapes::try_subdivide(&r.mesh, subdivide)? } else { r.mesh };
+    let mut mesh = if subdivide > 0 { geom::mesh::shapes::try_subdivide(&r.mesh, subdivide)? } else { r.mesh.clone() };
     if let Some(n) = simplify {
         let opts = geom::simplify::DecimateOptions { target_vertices: n, ..Default::default() };
         let d = geom::simplify::decimate(&mesh, &opts)?;
@@ -49,7 +52,14 @@ pub fn convert(
         }
         mesh = d.mesh;
     }
-    io::write_path(&mesh, output)?;
+    // A glTF output of an unchanged mesh keeps the input's own layout (seams, attributes).
+    let keep_layout = subdivide == 0 && simplify.is_none();
+    match (&r.layout, io::Format::from_extension(output)) {
+        (Some(l), Some(io::Format::Gltf)) if keep_layout => {
+            io::write_bytes(output, &io::write_layout_glb(&mesh, Some(l), &[]))?;
+        }
+        _ => io::write_path(&mesh, output)?,
+    }
     let s = geom::topology::summary(&mesh);
     Ok(json!({"written": output.display().to_string(), "vertices": s.vertices, "faces": s.faces,
               "warnings": r.warnings.iter().map(|w| &w.message).collect::<Vec<_>>()})
@@ -158,10 +168,10 @@ pub fn map(
         }
         (None, None) => return Err(geom::InputError::Spec("give --anchors or --spec".into()).into()),
     };
-    let s = read(source)?.mesh;
-    let t = read(target)?.mesh;
+    let (s, t) = (read(source)?, read(target)?);
     let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
-    let (report, artifacts) = geom::pipeline::run_job(&spec, &[s, t], &mut progress)?;
+    let (report, artifacts) =
+        geom::pipeline::run_with_layouts(&spec, &[s.mesh, t.mesh], &[s.layout, t.layout], &mut progress)?;
     finish(&progress, out, &artifacts, &report)
 }
 
@@ -170,9 +180,10 @@ pub fn remesh(meshes: &[std::path::PathBuf], spec: &Path, out: &Path) -> Result<
     let bytes =
         std::fs::read(spec).map_err(|e| geom::InputError::Invalid(format!("cannot read {}: {e}", spec.display())))?;
     let spec = geom::pipeline::JobSpec::from_json(&bytes)?;
-    let models = meshes.iter().map(|m| read(m).map(|r| r.mesh)).collect::<Result<Vec<_>>>()?;
+    let (models, layouts): (Vec<_>, Vec<_>) =
+        meshes.iter().map(|m| read(m).map(|r| (r.mesh, r.layout))).collect::<Result<Vec<_>>>()?.into_iter().unzip();
     let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
-    let (report, artifacts) = geom::pipeline::run_job(&spec, &models, &mut progress)?;
+    let (report, artifacts) = geom::pipeline::run_with_layouts(&spec, &models, &layouts, &mut progress)?;
     finish(&progress, out, &artifacts, &report)
 }
 

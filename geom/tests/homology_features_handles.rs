@@ -65,7 +65,7 @@ fn run_with(
     let (report, arts) = run_map(&sp, s, t, &mut NoProgress).unwrap();
     common::assert_artifacts(
         &arts,
-        &["basis_source.json", "basis_target.json", "domain_source.obj", "domain_target.obj", "morph.glb"],
+        &["basis_source.json", "basis_target.json", "domain_source.obj", "domain_target.obj"],
     );
     let f = &report.features;
     assert!(f.feature_error[0] <= 1e-9 && f.feature_error[1] <= 1e-9, "features off: {:?}", f.feature_error);

@@ -43,7 +43,6 @@ fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, bas
             "basis_target.json",
             "domain_source.obj",
             "domain_target.obj",
-            "morph.glb",
             "metrics.json",
         ],
     );

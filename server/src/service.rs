@@ -149,7 +149,11 @@ impl JobService {
         let limits = MeshLimits { max_vertices: self.limits.max_vertices, max_faces: 2 * self.limits.max_vertices + 8 };
         let (bytes, parsed) = tokio::task::spawn_blocking(move || {
             let r = geom::io::read(&bytes, &ReadOptions { limits, hint });
-            (bytes, r.map(|r| (r.format, geom::topology::summary(&r.mesh), r.warnings)))
+            let summary = |r: &geom::io::ReadResult| geom::topology::Summary {
+                input_vertices: r.layout.as_ref().map(|l| l.n_vertices()),
+                ..geom::topology::summary(&r.mesh)
+            };
+            (bytes, r.map(|r| (r.format, summary(&r), r.warnings)))
         })
         .await
         .map_err(ApiError::internal)?;

@@ -247,7 +247,7 @@ async fn homology_job_through_the_queue() {
     assert!(f["meta_mesh"]["faces"].as_u64().unwrap() >= 128 && f["meta_mesh"]["error"].is_null(), "{done}");
     let (_, list) = json_call(&t, "GET", &format!("/v1/jobs/{id}/artifacts"), Body::empty()).await;
     let names: Vec<&str> = list["artifacts"].as_array().unwrap().iter().filter_map(|a| a["name"].as_str()).collect();
-    for n in ["meta_source.obj", "meta_target.obj", "morph.glb"] {
+    for n in ["meta_source.obj", "meta_target.obj", "meta_morph.glb", "morph.glb"] {
         assert!(names.contains(&n), "{n} missing from {names:?}");
     }
     // Genus 0 has no homology basis: refused before queueing.
@@ -410,4 +410,47 @@ async fn uploads_over_the_shared_memory_budget_get_429() {
     drop(held);
     let req = Request::post("/v1/meshes").header("content-length", s.len()).body(Body::from(s)).unwrap();
     assert_eq!(call(&t, req).await.0, StatusCode::CREATED);
+}
+
+/// glTF uploads: a GLB split at seams is summarized with its own vertex count (the range of the
+/// ids a job names on it); a file that requires Draco is 422 `unsupported_extension`.
+#[tokio::test]
+async fn gltf_uploads_are_summarized_or_refused_by_extension() {
+    let t = setup().await;
+    // Two triangles of a tetrahedron's four split like a seam: 6 input vertices, 4 welded.
+    let tet = geom::mesh::shapes::tetrahedron();
+    let p: Vec<geom::mesh::P3> = tet.positions().to_vec();
+    let tris: Vec<[u32; 3]> = (0..4u32).map(|f| [3 * f, 3 * f + 1, 3 * f + 2]).collect();
+    let split: Vec<geom::mesh::P3> = tet.faces().iter().flat_map(|f| f.map(|v| p[v.idx()])).collect();
+    let attrs = geom::mesh::Attributes::default();
+    let glb = geom::io::write_glb_mesh(&geom::io::GlbMesh {
+        positions: &split,
+        triangles: &tris,
+        attributes: &attrs,
+        targets: &[],
+    });
+    let (st, m) = json_call(&t, "POST", "/v1/meshes", Body::from(glb.clone())).await;
+    assert_eq!(st, StatusCode::CREATED, "{m}");
+    assert_eq!((m["format"].as_str(), m["summary"]["vertices"].as_u64()), (Some("gltf"), Some(4)), "{m}");
+    assert_eq!(m["summary"]["input_vertices"], 12, "{m}");
+    // The same document requiring Draco.
+    let n = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let mut doc: Value = serde_json::from_slice(&glb[20..20 + n]).unwrap();
+    doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+    doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+    let mut js = serde_json::to_vec(&doc).unwrap();
+    while js.len() % 4 != 0 {
+        js.push(b' ');
+    }
+    let bin = &glb[20 + n..];
+    let mut out = b"glTF".to_vec();
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&((12 + 8 + js.len() + bin.len()) as u32).to_le_bytes());
+    out.extend_from_slice(&(js.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&js);
+    out.extend_from_slice(bin);
+    let (st, e) = json_call(&t, "POST", "/v1/meshes", Body::from(out)).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("unsupported_extension")), "{e}");
+    assert!(e["message"].as_str().unwrap().contains("KHR_draco_mesh_compression"), "{e}");
 }

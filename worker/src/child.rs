@@ -135,12 +135,15 @@ fn execute(dir: &Path, input: &ChildInput) -> geom::Result<ChildOutput> {
     let io = |e: std::io::Error| geom::Error::Internal(format!("job directory: {e}"));
     let limits = MeshLimits { max_vertices: input.max_vertices, max_faces: 2 * input.max_vertices + 8 };
     let mut meshes = Vec::with_capacity(input.meshes);
+    let mut layouts = Vec::with_capacity(input.meshes);
     for i in 0..input.meshes {
         let bytes = std::fs::read(dir.join(format!("mesh_{i}"))).map_err(io)?;
-        meshes.push(geom::io::read(&bytes, &ReadOptions { limits, hint: None })?.mesh);
+        let r = geom::io::read(&bytes, &ReadOptions { limits, hint: None })?;
+        meshes.push(r.mesh);
+        layouts.push(r.layout);
     }
     let mut progress = StdoutProgress { last: None };
-    let (report, artifacts) = geom::pipeline::run_job(&input.job, &meshes, &mut progress)?;
+    let (report, artifacts) = geom::pipeline::run_with_layouts(&input.job, &meshes, &layouts, &mut progress)?;
     let mut listed = Vec::with_capacity(artifacts.len());
     for (k, a) in artifacts.into_iter().enumerate() {
         std::fs::write(dir.join(format!("out_{k}")), &a.bytes).map_err(io)?;

@@ -63,11 +63,14 @@ impl Running {
                 let mut progress = shared.clone();
                 let handle = tokio::task::spawn_blocking(move || {
                     let opts = geom::io::ReadOptions { limits, hint: None };
-                    let meshes = meshes
+                    let (meshes, layouts): (Vec<_>, Vec<_>) = meshes
                         .iter()
-                        .map(|b| geom::io::read(b, &opts).map(|r| r.mesh))
-                        .collect::<geom::Result<Vec<_>>>()?;
-                    geom::pipeline::run_job(&job, &meshes, &mut progress).map(|(r, a)| (Box::new(r), a))
+                        .map(|b| geom::io::read(b, &opts).map(|r| (r.mesh, r.layout)))
+                        .collect::<geom::Result<Vec<_>>>()?
+                        .into_iter()
+                        .unzip();
+                    geom::pipeline::run_with_layouts(&job, &meshes, &layouts, &mut progress)
+                        .map(|(r, a)| (Box::new(r), a))
                 });
                 Ok(Running::Thread { handle, result: None })
             }

@@ -188,17 +188,17 @@ fn anchor_pairs(
     let mut out = Vec::with_capacity(n);
     let (mut seen_s, mut seen_t) = (std::collections::HashMap::new(), std::collections::HashMap::new());
     for (i, &[s, t]) in anchors.iter().enumerate() {
-        if s >= ss.vertices as u64 {
+        if s >= ss.id_count() as u64 {
             return Err(InputError::Anchors(format!(
                 "anchor {i}: source vertex {s} is out of range (source has {} vertices)",
-                ss.vertices
+                ss.id_count()
             ))
             .into());
         }
-        if t >= ts.vertices as u64 {
+        if t >= ts.id_count() as u64 {
             return Err(InputError::Anchors(format!(
                 "anchor {i}: target vertex {t} is out of range (target has {} vertices)",
-                ts.vertices
+                ts.id_count()
             ))
             .into());
         }

@@ -3,7 +3,7 @@
 //! domains -> maps both ways -> anchor snapping -> smoothing with every feature vertex held ->
 //! metrics (with the feature error) -> artifacts.
 
-use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, morph_glb, planar_obj};
+use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
 use super::common::relax::finish_pair;
 use super::common::{Artifact, Clock, PairReport, artifacts, json_artifact};
 use super::spec::HomologySpec;
@@ -146,8 +146,8 @@ pub fn run(
         morph = m;
         clock.lap("meta_mesh");
     }
-    // The morph: the meta-mesh pair when there is one, else the source to its image.
-    arts.push(morph.unwrap_or_else(|| morph_glb(source, f.on_target.positions())));
+    // The meta-mesh morph; `morph.glb` of the source is added by `run_job`.
+    arts.extend(morph);
     let (bs, bt) = (r.handles.as_ref().map(|h| &h.source), r.handles.as_ref().map(|h| &h.target));
     arts.push(json_artifact("basis_source.json", &cut_json(&r.source, source, bs))?);
     arts.push(json_artifact("basis_target.json", &cut_json(&r.target, target, bt))?);
@@ -155,7 +155,7 @@ pub fn run(
     arts.push(planar_obj("domain_target.obj", &r.target.domain.uv, &r.target.cut.disk.mesh)?);
     clock.lap("artifacts");
     let pair = PairReport::new("homology", pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
-    let mut report = FeatureMapReport { pair, features: report_f };
+    let mut report = FeatureMapReport { pair: pair.with_maps(f.s2t, f.t2s), features: report_f };
     report.pair.timings_ms = clock.finish();
     arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);

@@ -2,7 +2,7 @@
 //! the 4g-gon -> anchor snapping -> relaxation -> metrics -> artifacts (bases and domains
 //! included).
 
-use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, morph_glb, planar_obj};
+use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
 use super::common::relax::finish_pair;
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
 use super::spec::HomologySpec;
@@ -146,16 +146,16 @@ pub fn run(
         loop_lengths: [len(&r.source), len(&r.target)],
         meta_mesh: meta,
     };
-    // The morph: the meta-mesh from source to target when there is one (every detail of both),
-    // else the source mesh to its image on the target.
-    arts.push(morph.unwrap_or_else(|| morph_glb(source, f.on_target.positions())));
+    // The meta-mesh morph (every detail of both); `morph.glb` of the source is added by
+    // `run_job` for every pair method.
+    arts.extend(morph);
     arts.push(json_artifact("basis_source.json", &basis_json(&r.source))?);
     arts.push(json_artifact("basis_target.json", &basis_json(&r.target))?);
     arts.push(planar_obj("domain_source.obj", &r.source.domain.uv, &r.source.basis.disk.mesh)?);
     arts.push(planar_obj("domain_target.obj", &r.target.domain.uv, &r.target.basis.disk.mesh)?);
     clock.lap("artifacts");
     let pair = PairReport::new("homology", pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
-    let mut report = HomologyMapReport { pair, homology: report_h };
+    let mut report = HomologyMapReport { pair: pair.with_maps(f.s2t, f.t2s), homology: report_h };
     report.pair.timings_ms = clock.finish();
     arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);

@@ -12,6 +12,8 @@ pub mod features;
 mod folds;
 mod global_choice;
 pub mod homology;
+mod input_ids;
+mod layout_outputs;
 mod limits;
 mod memory;
 mod optimize;
@@ -31,7 +33,7 @@ pub use spec::{
 };
 
 use crate::error::{InputError, Result};
-use crate::mesh::Mesh;
+use crate::mesh::{InputLayout, Mesh};
 use crate::progress::Progress;
 use serde::Serialize;
 
@@ -82,6 +84,23 @@ impl JobReport {
 /// # Errors
 /// `InputError::Spec` for the wrong number of meshes; `MapFolds`; whatever the method reports.
 pub fn run_job(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Result<(JobReport, Vec<Artifact>)> {
+    run_with_layouts(spec, meshes, &[], progress)
+}
+
+/// [`run_job`] on inputs read with their own layouts (glTF, OBJ with seams): vertex ids of
+/// the spec count each input's own vertices, and `morph.glb` is the source in its layout with
+/// its attributes. `layouts` may be shorter than `meshes` (missing = none).
+///
+/// # Errors
+/// As [`run_job`]; `InputError::Anchors` for an id past an input's vertices.
+pub fn run_with_layouts(
+    spec: &JobSpec,
+    meshes: &[Mesh],
+    layouts: &[Option<InputLayout>],
+    progress: &mut dyn Progress,
+) -> Result<(JobReport, Vec<Artifact>)> {
+    let layouts: Vec<Option<&InputLayout>> = layouts.iter().map(Option::as_ref).collect();
+    let spec = &*input_ids::to_welded(spec, &layouts)?;
     let pair = || match meshes {
         [s, t] => Ok((s, t)),
         _ => Err(InputError::Spec(format!(
@@ -112,6 +131,7 @@ pub fn run_job(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> 
         }
     };
     folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
+    layout_outputs::add_morph(&report, meshes, &layouts, &mut arts);
     Ok((report, arts))
 }
 #[cfg(test)]

@@ -139,7 +139,7 @@ impl QuadSpec {
             }
             let mut ids = Vec::with_capacity(n);
             for (m, &v) in row.iter().enumerate() {
-                if v >= summaries[m].vertices as u64 {
+                if v >= summaries[m].id_count() as u64 {
                     return Err(InputError::Anchors(format!(
                         "anchor row {r}: vertex {v} is out of range for mesh {m} ({} vertices)",
                         summaries[m].vertices

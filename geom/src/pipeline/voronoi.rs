@@ -312,6 +312,7 @@ fn run_with(
     let mut report = LayoutMapReport { pair, patches: patches.len(), layout: stats, global, optimize: optimized };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, (&s2t, &t2s), &on_target, &on_source)?;
     clock.lap("artifacts");
+    report.pair = report.pair.with_maps(s2t, t2s);
     report.pair.timings_ms = clock.finish();
     arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);

@@ -34,6 +34,17 @@ pub struct Summary {
     pub bbox: [[f64; 3]; 2],
     pub bbox_diagonal: f64,
     pub area: f64,
+    /// The file's own vertex count when it splits vertices at seams (glTF): the range of the
+    /// vertex ids a job names on it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub input_vertices: Option<usize>,
+}
+
+impl Summary {
+    /// How many vertex ids a job may name on this mesh.
+    pub fn id_count(&self) -> usize {
+        self.input_vertices.unwrap_or(self.vertices)
+    }
 }
 
 /// Euler characteristic V - E + F.
@@ -67,6 +78,7 @@ pub fn summary(mesh: &Mesh) -> Summary {
         bbox: [[lo.x, lo.y, lo.z], [hi.x, hi.y, hi.z]],
         bbox_diagonal: (hi - lo).norm(),
         area: mesh.area(),
+        input_vertices: None,
     }
 }
 

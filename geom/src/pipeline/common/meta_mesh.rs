@@ -71,16 +71,16 @@ pub fn meta_outputs(
                 content_type: "model/obj",
                 bytes: io::write(&mt, Format::Obj),
             });
-            (stats, Some(morph_glb(&ms, mt.positions())))
+            (stats, Some(morph_glb("meta_morph.glb", &ms, mt.positions())))
         }
         Err(e) => (MetaMeshStats { error: Some(e.to_string()), ..stats }, None),
     }
 }
 
-/// `morph.glb`: `base` with one morph target, the same vertices at `to` (glTF 2.0, binary).
-pub fn morph_glb(base: &Mesh, to: &[P3]) -> Artifact {
+/// A morph: `base` with one morph target, the same vertices at `to` (glTF 2.0, binary).
+pub fn morph_glb(name: &str, base: &Mesh, to: &[P3]) -> Artifact {
     Artifact {
-        name: "morph.glb".into(),
+        name: name.into(),
         content_type: "model/gltf-binary",
         bytes: io::write_glb(base.positions(), &base.face_indices(), &[("target".into(), to.to_vec())]),
     }

@@ -9,6 +9,7 @@ pub mod relax;
 
 use crate::crossparam::smooth::SmoothReport;
 use crate::error::{Error, Result};
+use crate::map::SurfaceMap;
 use crate::mesh::Mesh;
 use crate::metrics::MapMetrics;
 use serde::Serialize;
@@ -80,6 +81,17 @@ pub struct PairReport {
     /// meta-mesh pair was built instead; otherwise a folded map fails the job).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub withheld: Vec<String>,
+    /// The maps themselves (not in `metrics.json`), for the outputs `run_job` builds in the
+    /// inputs' own layouts.
+    #[serde(skip)]
+    pub maps: Option<std::sync::Arc<PairMaps>>,
+}
+
+/// Both vertex maps of a pair job.
+#[derive(Debug)]
+pub struct PairMaps {
+    pub s2t: SurfaceMap,
+    pub t2s: SurfaceMap,
 }
 
 impl PairReport {
@@ -100,7 +112,13 @@ impl PairReport {
             timings_ms: Vec::new(),
             smoothing,
             withheld: Vec::new(),
+            maps: None,
         }
+    }
+
+    /// The report carrying both maps.
+    pub fn with_maps(self, s2t: SurfaceMap, t2s: SurfaceMap) -> PairReport {
+        PairReport { maps: Some(std::sync::Arc::new(PairMaps { s2t, t2s })), ..self }
     }
 }
 

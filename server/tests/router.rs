@@ -439,7 +439,7 @@ async fn gltf_uploads_are_summarized_or_refused_by_extension() {
     doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
     doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
     let mut js = serde_json::to_vec(&doc).unwrap();
-    while js.len() % 4 != 0 {
+    while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
     let bin = &glb[20 + n..];

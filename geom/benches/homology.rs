@@ -32,7 +32,11 @@ fn bench(c: &mut Criterion) {
     }
     let s = load("kitten.nf20k.off");
     let t = bent(&s);
-    let spec = HomologySpec { anchors: vec![[0, 0]], features: Vec::new(), options: HomologyOptions::default() };
+    let spec = HomologySpec {
+        anchors: geom::pipeline::AnchorRow::ids([[0, 0]]),
+        features: Vec::new(),
+        options: HomologyOptions::default(),
+    };
     g.bench_function("kitten_bent_genus1_map", |b| b.iter(|| run_map(&spec, &s, &t, &mut NoProgress).expect("map")));
     g.finish();
 }

@@ -15,7 +15,7 @@ use common::load;
 fn run(s: &Mesh, t: &Mesh, basis: [usize; 2], rotation: usize) -> HomologyMapReport {
     let spec = HomologySpec {
         features: Vec::new(),
-        anchors: vec![[0, 0]],
+        anchors: geom::pipeline::AnchorRow::ids(vec![[0, 0]]),
         options: HomologyOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
     };
     run_map(&spec, s, t, &mut NoProgress).unwrap().0
@@ -51,7 +51,7 @@ fn kitten_to_rocker_arm_in_two_homotopy_classes_without_flips() {
     for rotation in [1, 2] {
         let spec = HomologySpec {
             features: Vec::new(),
-            anchors: vec![[0, 0]],
+            anchors: geom::pipeline::AnchorRow::ids(vec![[0, 0]]),
             options: HomologyOptions { metric_samples: 5000, rotation, ..Default::default() },
         };
         let (r, arts) = run_map(&spec, &s, &t, &mut NoProgress).unwrap();

@@ -30,7 +30,7 @@ fn spec_pairs<'a>(
 ) -> HomologySpec {
     let raw = |p: &Vec<VertexId>| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
     HomologySpec {
-        anchors,
+        anchors: geom::pipeline::AnchorRow::ids(anchors),
         features: pairs.map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) }).collect(),
         options: HomologyOptions { metric_samples: 5000, ..Default::default() },
     }

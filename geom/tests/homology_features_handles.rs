@@ -46,7 +46,7 @@ fn job(s: &Mesh, gt: &[u32], (c, tc): (&[Vec<VertexId>], &[Vec<VertexId>]), opti
     let base = far_from(s, c);
     let raw = |p: &[VertexId]| p.iter().map(|v| v.0 as u64).collect::<Vec<_>>();
     HomologySpec {
-        anchors: vec![[base.0 as u64, gt[base.idx()] as u64]],
+        anchors: geom::pipeline::AnchorRow::ids([[base.0 as u64, gt[base.idx()] as u64]]),
         features: c.iter().zip(tc).map(|(p, q)| FeatureSpec { source: raw(p), target: raw(q) }).collect(),
         options,
     }
@@ -183,7 +183,7 @@ fn a_base_on_a_feature_or_boundary_with_handles_is_refused() {
     let s = load("torus.obj");
     let c = curves(&s, 1);
     let sp = |anchors: Vec<[u64; 2]>| HomologySpec {
-        anchors,
+        anchors: geom::pipeline::AnchorRow::ids(anchors),
         features: vec![FeatureSpec {
             source: c[0].iter().map(|v| v.0 as u64).collect(),
             target: c[0].iter().map(|v| v.0 as u64).collect(),

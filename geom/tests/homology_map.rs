@@ -10,6 +10,7 @@ use geom::progress::NoProgress;
 
 mod common;
 use common::{bent, load, shuffled, subdivided};
+use geom::pipeline::AnchorRow;
 
 struct Run {
     report: HomologyMapReport,
@@ -24,7 +25,7 @@ fn run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, basis: 
 fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, basis: [usize; 2]) -> Option<Run> {
     let spec = HomologySpec {
         features: Vec::new(),
-        anchors: anchors.iter().map(|&a| [a as u64, gt[a as usize] as u64]).collect(),
+        anchors: AnchorRow::ids(anchors.iter().map(|&a| [a as u64, gt[a as usize] as u64])),
         options: HomologyOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
     };
     let (report, arts) = match run_map(&spec, s, t, &mut NoProgress) {
@@ -162,7 +163,7 @@ fn another_triangulation_genus_one_and_two() {
 fn check_meta(s: &Mesh, t: &Mesh, anchors: &[[u64; 2]], what: &str, prune: Option<f64>) -> usize {
     let spec = HomologySpec {
         features: Vec::new(),
-        anchors: anchors.to_vec(),
+        anchors: AnchorRow::ids(anchors.iter().copied()),
         options: HomologyOptions {
             metric_samples: 2000,
             meta_mesh: true,
@@ -197,7 +198,7 @@ fn a_curve_matching_selects_its_class() {
     let (t, gt) = shuffled(&s);
     let job = |m: &[&str]| HomologySpec {
         features: Vec::new(),
-        anchors: vec![[0, gt[0] as u64]],
+        anchors: AnchorRow::ids([[0, gt[0] as u64]]),
         options: HomologyOptions {
             metric_samples: 2000,
             matching: Some(m.iter().map(|x| x.to_string()).collect()),

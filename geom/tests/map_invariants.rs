@@ -44,7 +44,10 @@ fn check_with(
     area: std::ops::RangeInclusive<f64>,
 ) -> Checked {
     let anchors: Vec<[u64; 2]> = fps(s, k).into_iter().map(|a| [a as u64, gt[a as usize] as u64]).collect();
-    let spec = LayoutSpec { anchors: anchors.clone(), options: MapOptions { metric_samples: 5000, ..options } };
+    let spec = LayoutSpec {
+        anchors: geom::pipeline::AnchorRow::ids(anchors.clone()),
+        options: MapOptions { metric_samples: 5000, ..options },
+    };
     let (rep, arts) = run_layout(method, &spec, s, t, &mut NoProgress).unwrap();
     let names: Vec<&str> = arts.iter().map(|a| a.name.as_str()).collect();
     for n in [

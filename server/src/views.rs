@@ -147,8 +147,11 @@ pub struct SpecOutline {
     /// voronoi | greedy | homology | quad
     #[schema(pattern = "^(voronoi|greedy|homology|quad)$")]
     method: String,
-    /// Vertex-id rows: `[source, target]` for pair jobs, one id per mesh for `quad`.
-    anchors: Vec<Vec<u64>>,
+    /// Rows: `[source, target]` vertex ids for pair jobs (or `{"source": [x, y, z], "target":
+    /// [x, y, z]}`, or `{"source": {"face": f, "bary": [u, v, w]}, "target": ...}` surface
+    /// points); one id per mesh for `quad`.
+    #[schema(value_type = Vec<Object>)]
+    anchors: Vec<serde_json::Value>,
     /// `homology`: corresponding feature curves.
     #[schema(value_type = Option<Vec<Object>>)]
     features: Option<Vec<serde_json::Value>>,

@@ -13,7 +13,7 @@ use surfmap_proto::v1::surfmap_client::SurfmapClient;
 
 static ONE_AT_A_TIME: tokio::sync::Mutex<()> = tokio::sync::Mutex::const_new(());
 
-const ARTIFACTS: [&str; 8] = [
+const ARTIFACTS: [&str; 9] = [
     "source_on_target.obj",
     "target_on_source.obj",
     "source_to_target.csv",
@@ -21,6 +21,7 @@ const ARTIFACTS: [&str; 8] = [
     "layout.json",
     "layout_source.ply",
     "layout_target.ply",
+    "morph.glb",
     "metrics.json",
 ];
 

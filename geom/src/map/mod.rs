@@ -4,4 +4,5 @@
 
 mod surface_map;
 
+pub mod transfer;
 pub use surface_map::SurfaceMap;

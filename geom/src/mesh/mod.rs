@@ -10,6 +10,7 @@ mod build;
 pub mod cut;
 mod cut_copy;
 mod ids;
+pub mod insert;
 pub mod layout;
 pub mod refine;
 pub mod shapes;

@@ -1,6 +1,7 @@
 //! A job checked against its meshes' summaries before any work starts (the server answers
 //! with these errors before it queues a job; the pipeline checks again on the meshes).
 
+use super::anchor_spec::AnchorRow;
 use super::limits::{MAX_ANCHORS, MAX_FEATURES};
 use super::spec::{HomologySpec, JobSpec, LayoutSpec, Method};
 use crate::error::{InputError, Result};
@@ -167,7 +168,7 @@ fn same_topology(ss: &Summary, ts: &Summary) -> Result<()> {
 /// At least `need` and at most [`MAX_ANCHORS`] anchors, each in range on its mesh, no vertex
 /// used twice on one mesh.
 fn anchor_pairs(
-    anchors: &[[u64; 2]],
+    anchors: &[AnchorRow],
     method: Method,
     need: usize,
     ss: &Summary,
@@ -187,7 +188,17 @@ fn anchor_pairs(
     }
     let mut out = Vec::with_capacity(n);
     let (mut seen_s, mut seen_t) = (std::collections::HashMap::new(), std::collections::HashMap::new());
-    for (i, &[s, t]) in anchors.iter().enumerate() {
+    for (i, row) in anchors.iter().enumerate() {
+        // Point rows are checked here as far as the summaries allow; they become vertex ids
+        // (inserted vertices included) before a method runs, and are checked again then.
+        let &[s, t] = match row {
+            AnchorRow::Ids(x) => x,
+            AnchorRow::Points(p) => {
+                p.source.check(i, "source", ss.faces)?;
+                p.target.check(i, "target", ts.faces)?;
+                continue;
+            }
+        };
         if s >= ss.id_count() as u64 {
             return Err(InputError::Anchors(format!(
                 "anchor {i}: source vertex {s} is out of range (source has {} vertices)",
@@ -221,7 +232,10 @@ mod tests {
     #[test]
     fn a_negative_smoothing_step_is_out_of_range() {
         let m = shapes::icosphere(1);
-        let mut spec = LayoutSpec { anchors: vec![[0, 0], [3, 3], [7, 7]], options: Default::default() };
+        let mut spec = LayoutSpec {
+            anchors: crate::pipeline::AnchorRow::ids(vec![[0, 0], [3, 3], [7, 7]]),
+            options: Default::default(),
+        };
         assert!(spec.validate(Method::Voronoi, &m, &m).is_ok());
         spec.options.smoothing.step = -1.0;
         let e = spec.validate(Method::Voronoi, &m, &m).unwrap_err();
@@ -232,7 +246,10 @@ mod tests {
     #[test]
     fn the_wrong_number_of_meshes_is_a_spec_error() {
         let m = topology::summary(&shapes::icosphere(1));
-        let spec = JobSpec::Greedy(LayoutSpec { anchors: vec![[0, 0], [3, 3], [7, 7]], options: Default::default() });
+        let spec = JobSpec::Greedy(LayoutSpec {
+            anchors: crate::pipeline::AnchorRow::ids(vec![[0, 0], [3, 3], [7, 7]]),
+            options: Default::default(),
+        });
         assert!(spec.check(&[m.clone(), m.clone()]).is_ok());
         assert_eq!(spec.check(&[m.clone(), m.clone(), m]).unwrap_err().code(), "invalid_spec");
     }

@@ -93,8 +93,8 @@ pub(super) fn refuse_folds(
 
 fn spec_anchors(spec: &JobSpec) -> Vec<[u64; 2]> {
     match spec {
-        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => s.anchors.clone(),
-        JobSpec::Homology(s) => s.anchors.clone(),
+        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
+        JobSpec::Homology(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
         JobSpec::Quad(_) => Vec::new(),
     }
 }
@@ -151,7 +151,7 @@ mod tests {
         let t = stretched(&s);
         let anchors: Vec<[u64; 2]> = [0u64, 5, 9, 13, 21, 40].iter().map(|&i| [i, i]).collect();
         let spec = JobSpec::Voronoi(LayoutSpec {
-            anchors,
+            anchors: crate::pipeline::AnchorRow::ids(anchors),
             options: MapOptions { metric_samples: 1000, ..Default::default() },
         });
         let meshes = [s, t];
@@ -175,7 +175,11 @@ mod tests {
         let s = shapes::torus(16, 8, 1.0, 0.35);
         let t = stretched(&s);
         let options = HomologyOptions { meta_mesh: true, metric_samples: 1000, ..Default::default() };
-        let spec = JobSpec::Homology(HomologySpec { anchors: vec![[0, 0]], features: Vec::new(), options });
+        let spec = JobSpec::Homology(HomologySpec {
+            anchors: crate::pipeline::AnchorRow::ids(vec![[0, 0]]),
+            features: Vec::new(),
+            options,
+        });
         let meshes = [s, t];
         let (mut report, mut arts) = run_job(&spec, &meshes, &mut NoProgress).unwrap();
         let JobReport::Homology(r) = &mut report else { panic!("a homology report") };

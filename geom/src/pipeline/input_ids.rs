@@ -4,6 +4,7 @@
 //! anchor, feature-curve vertex and quad marker of that mesh goes through
 //! [`InputLayout::welded`]; other inputs' ids are the mesh's already.
 
+use super::anchor_spec::AnchorRow;
 use super::spec::JobSpec;
 use crate::error::{InputError, Result};
 use crate::mesh::InputLayout;
@@ -23,6 +24,18 @@ fn map_id(id: &mut u64, table: Option<&[u32]>, mesh: usize) -> Result<()> {
     Ok(())
 }
 
+/// Vertex-id anchor rows through the tables (point rows are not ids).
+fn id_rows<'t>(rows: &mut [AnchorRow], table: &dyn Fn(usize) -> Option<&'t [u32]>) -> Result<()> {
+    for row in rows {
+        if let AnchorRow::Ids(ids) = row {
+            for (k, id) in ids.iter_mut().enumerate() {
+                map_id(id, table(k), k)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The spec with every vertex id in welded numbering (borrowed when nothing changes).
 ///
 /// # Errors
@@ -36,19 +49,9 @@ pub fn to_welded<'a>(spec: &'a JobSpec, layouts: &[Option<&InputLayout>]) -> Res
     let table = |k: usize| tables.get(k).copied().flatten();
     let mut s = spec.clone();
     match &mut s {
-        JobSpec::Voronoi(l) | JobSpec::Greedy(l) => {
-            for row in &mut l.anchors {
-                for (k, id) in row.iter_mut().enumerate() {
-                    map_id(id, table(k), k)?;
-                }
-            }
-        }
+        JobSpec::Voronoi(l) | JobSpec::Greedy(l) => id_rows(&mut l.anchors, &table)?,
         JobSpec::Homology(h) => {
-            for row in &mut h.anchors {
-                for (k, id) in row.iter_mut().enumerate() {
-                    map_id(id, table(k), k)?;
-                }
-            }
+            id_rows(&mut h.anchors, &table)?;
             for f in &mut h.features {
                 for id in &mut f.source {
                     map_id(id, table(0), 0)?;

@@ -7,8 +7,16 @@ use crate::io;
 use crate::mesh::{InputLayout, Mesh, P3, VertexId};
 
 /// Adds `morph.glb` to a pair job's artifacts (not when a folded direction was withheld).
-pub fn add_morph(report: &JobReport, meshes: &[Mesh], layouts: &[Option<&InputLayout>], arts: &mut Vec<Artifact>) {
-    let (Some(pair), [source, target]) = (report.pair(), meshes) else {
+/// `originals` are the inputs, `meshes` what the job ran on (with vertices inserted at point
+/// anchors, which come after the original ones and are left out).
+pub fn add_morph(
+    report: &JobReport,
+    originals: &[Mesh],
+    meshes: &[Mesh],
+    layouts: &[Option<&InputLayout>],
+    arts: &mut Vec<Artifact>,
+) {
+    let (Some(pair), [source, _], [_, target]) = (report.pair(), originals, meshes) else {
         return;
     };
     let Some(maps) = pair.maps.as_ref() else {

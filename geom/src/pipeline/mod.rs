@@ -6,6 +6,8 @@
 //! feature curves or boundaries, [`quad`]). Each imports [`common`] and the spec, never another
 //! method's file.
 
+mod anchor_points;
+mod anchor_spec;
 mod check;
 pub mod common;
 pub mod features;
@@ -21,8 +23,10 @@ pub mod quad;
 mod quad_spec;
 mod ranges;
 mod spec;
+mod transfer_output;
 pub mod voronoi;
 
+pub use anchor_spec::{AnchorPoints, AnchorRow, FacePoint, PointRef};
 pub use common::{Artifact, PairReport};
 pub use limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_FEATURES, MAX_METRIC_SAMPLES, MAX_MODELS, MAX_MORPH_FRAMES};
 pub use quad::{QuadReport, Remeshes, remesh_all_for_bench};
@@ -101,6 +105,21 @@ pub fn run_with_layouts(
 ) -> Result<(JobReport, Vec<Artifact>)> {
     let layouts: Vec<Option<&InputLayout>> = layouts.iter().map(Option::as_ref).collect();
     let spec = &*input_ids::to_welded(spec, &layouts)?;
+    let originals = meshes;
+    let transfer = match spec {
+        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => transfer_output::parse(&s.options.transfer)?,
+        JobSpec::Homology(s) => transfer_output::parse(&s.options.transfer)?,
+        JobSpec::Quad(_) => Default::default(),
+    };
+    let wants_transfer = !transfer.texcoords.is_empty() || transfer.color || transfer.skin;
+    if let (true, Some(source)) = (wants_transfer, meshes.first()) {
+        transfer_output::check_source(&transfer, source, layouts.first().copied().flatten())?;
+    }
+    let resolved = anchor_points::resolve(spec, meshes)?;
+    let (spec, meshes) = match &resolved {
+        Some(r) => (&r.spec, r.meshes.as_slice()),
+        None => (spec, meshes),
+    };
     let pair = || match meshes {
         [s, t] => Ok((s, t)),
         _ => Err(InputError::Spec(format!(
@@ -130,8 +149,16 @@ pub fn run_with_layouts(
             (JobReport::Quad(r), arts)
         }
     };
+    if let (Some(r), Some(pair)) = (&resolved, report.pair_mut()) {
+        pair.anchor_points = r.snaps.clone();
+        arts.retain(|a| a.name != "metrics.json");
+        arts.push(common::json_artifact("metrics.json", &report)?);
+    }
     folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
-    layout_outputs::add_morph(&report, meshes, &layouts, &mut arts);
+    layout_outputs::add_morph(&report, originals, meshes, &layouts, &mut arts);
+    if wants_transfer {
+        transfer_output::add(&report, &transfer, (originals, meshes), &layouts, &mut arts)?;
+    }
     Ok((report, arts))
 }
 #[cfg(test)]
@@ -172,7 +199,10 @@ mod cancel_tests {
             s.with_positions(s.positions().iter().map(|p| crate::mesh::P3::new(p.x * 1.4, p.y, p.z * 0.8)).collect());
         let t = t.unwrap();
         let anchors: Vec<[u64; 2]> = [0u64, 5, 9, 13, 21, 40].iter().map(|&i| [i, i]).collect();
-        let spec = JobSpec::Voronoi(LayoutSpec { anchors, options: MapOptions::default() });
+        let spec = JobSpec::Voronoi(LayoutSpec {
+            anchors: crate::pipeline::AnchorRow::ids(anchors),
+            options: MapOptions::default(),
+        });
         let mut p = CancelAt { stage: Stage::Smooth, token: CancelToken::default(), seen: Vec::new() };
         let r = run_job(&spec, &[s, t], &mut p);
         assert!(matches!(r, Err(Error::Cancelled)), "{:?}", r.err());

@@ -61,6 +61,7 @@ impl MapOptions {
         real("layout.flip.max_end_angle", l.flip.max_end_angle, 0.0, 1.0, true)?;
         size("param.stretch_iterations", self.param.stretch_iterations, 0, 100)?;
         smoothing(&self.smoothing)?;
+        super::transfer_output::parse(&self.transfer)?;
         size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)
     }
 }
@@ -74,6 +75,7 @@ impl HomologyOptions {
         size("basis[0]", self.basis[0], 0, 64)?;
         size("basis[1]", self.basis[1], 0, 64)?;
         size("rotation", self.rotation, 0, 1_000)?;
+        super::transfer_output::parse(&self.transfer)?;
         if let Some(d) = self.dihedral_threshold_deg {
             real("dihedral_threshold_deg", d, 0.0, 180.0, true)?;
         }

@@ -6,6 +6,7 @@
 //! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}`.
 //! Each method has its own options type; unknown fields are refused at every depth.
 
+use super::anchor_spec::AnchorRow;
 use super::quad_spec::QuadSpec;
 use crate::crossparam::PatchParamOptions;
 use crate::crossparam::smooth::SmoothOptions;
@@ -50,7 +51,7 @@ impl Method {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LayoutSpec {
-    pub anchors: Vec<[u64; 2]>,
+    pub anchors: Vec<AnchorRow>,
     #[serde(default)]
     pub options: MapOptions,
 }
@@ -59,7 +60,7 @@ pub struct LayoutSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HomologySpec {
-    pub anchors: Vec<[u64; 2]>,
+    pub anchors: Vec<AnchorRow>,
     /// Corresponding feature curves, mapped exactly.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub features: Vec<FeatureSpec>,
@@ -90,6 +91,10 @@ pub struct MapOptions {
     pub smoothing: SmoothOptions,
     /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
     pub metric_samples: usize,
+    /// Source attributes to carry onto the target (`target_transferred.glb`), e.g.
+    /// `["TEXCOORD_0", "JOINTS_0", "WEIGHTS_0"]`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub transfer: Vec<String>,
 }
 
 impl Default for MapOptions {
@@ -100,6 +105,7 @@ impl Default for MapOptions {
             global: GlobalOptions::default(),
             smoothing: SmoothOptions::default(),
             metric_samples: 100_000,
+            transfer: Vec::new(),
         }
     }
 }
@@ -142,6 +148,9 @@ pub struct HomologyOptions {
     pub smoothing: SmoothOptions,
     /// Surface samples per direction for the Hausdorff / RMS metrics.
     pub metric_samples: usize,
+    /// As [`MapOptions::transfer`].
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub transfer: Vec<String>,
 }
 
 impl Default for HomologyOptions {
@@ -155,6 +164,7 @@ impl Default for HomologyOptions {
             align_curves: true,
             smoothing: SmoothOptions::default(),
             metric_samples: 100_000,
+            transfer: Vec::new(),
         }
     }
 }
@@ -218,8 +228,8 @@ impl JobSpec {
         #[derive(Deserialize)]
         #[serde(untagged)]
         enum A {
-            Obj { anchors: Vec<[u64; 2]> },
-            List(Vec<[u64; 2]>),
+            Obj { anchors: Vec<AnchorRow> },
+            List(Vec<AnchorRow>),
         }
         let a: A = serde_json::from_slice(bytes).map_err(|e| InputError::Spec(format!("anchors file: {e}")))?;
         let (A::Obj { anchors } | A::List(anchors)) = a;

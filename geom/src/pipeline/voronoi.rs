@@ -335,7 +335,7 @@ mod tests {
         options.layout.max_attempts = 1;
         options.layout.rebuilds = 0;
         options.layout.greedy_fallback = false;
-        let spec = LayoutSpec { anchors, options };
+        let spec = LayoutSpec { anchors: crate::pipeline::AnchorRow::ids(anchors), options };
         let Err(Error::Input(e @ InputError::LayoutConflict(_))) = run(Method::Voronoi, &spec, &m, &m, &mut NoProgress)
         else {
             panic!("expected a layout conflict");
@@ -353,7 +353,7 @@ mod tests {
         let m = shapes::icosphere(3);
         let mut options = MapOptions { metric_samples: 1000, ..Default::default() };
         options.smoothing.iterations = 0;
-        let spec = LayoutSpec { anchors: (0..12).map(|i| [i, i]).collect(), options };
+        let spec = LayoutSpec { anchors: crate::pipeline::AnchorRow::ids((0..12).map(|i| [i, i])), options };
         let go = GlobalParamOptions { force: true, ..Default::default() };
         let (r, arts) = run_with(Method::Voronoi, &spec, &go, optimize::GATE, &m, &m, &mut NoProgress).unwrap();
         let g = r.global.unwrap();
@@ -385,7 +385,7 @@ mod tests {
         let mut options = MapOptions { metric_samples: 2000, ..Default::default() };
         options.smoothing.iterations = 0;
         options.global.enabled = false;
-        let spec = LayoutSpec { anchors, options };
+        let spec = LayoutSpec { anchors: crate::pipeline::AnchorRow::ids(anchors), options };
         let go = GlobalParamOptions { enabled: false, ..Default::default() };
         let (plain, _) = run_with(Method::Voronoi, &spec, &go, f64::INFINITY, &s, &t, &mut NoProgress).unwrap();
         let (opt, _) = run_with(Method::Voronoi, &spec, &go, 0.0, &s, &t, &mut NoProgress).unwrap();

@@ -85,6 +85,10 @@ pub struct PairReport {
     /// inputs' own layouts.
     #[serde(skip)]
     pub maps: Option<std::sync::Arc<PairMaps>>,
+    /// Anchors given as surface points: the vertex each became, its distance from the given
+    /// position, whether it was inserted.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub anchor_points: Vec<super::anchor_points::AnchorSnap>,
 }
 
 /// Both vertex maps of a pair job.
@@ -113,6 +117,7 @@ impl PairReport {
             smoothing,
             withheld: Vec::new(),
             maps: None,
+            anchor_points: Vec::new(),
         }
     }
 

@@ -1,0 +1,128 @@
+//! Anchor rows given as surface points become vertex ids before a method runs: a position is
+//! snapped to the nearest point of the surface (exact closest point on a triangle, through the
+//! metrics' BVH), a face point is taken as given; within 1e-9 of the bounding-box diagonal of a
+//! vertex (or 1% of the face's shortest edge, so no sliver is made) the anchor is that vertex,
+//! else a vertex is inserted there (`mesh::insert`). Each snap's distance is reported.
+
+use super::anchor_spec::{AnchorRow, PointRef};
+use super::spec::JobSpec;
+use crate::error::{InputError, Result};
+use crate::mesh::insert::{barycentric, insert_points};
+use crate::mesh::{FaceId, Mesh, P3};
+use crate::metrics::SurfaceIndex;
+use serde::Serialize;
+
+/// Relative snapping tolerance (of the bounding-box diagonal).
+pub const SNAP_TOL: f64 = 1e-9;
+
+/// One side of a point anchor, as resolved.
+#[derive(Debug, Clone, Serialize)]
+pub struct SideSnap {
+    /// The vertex the anchor uses (of the mesh with inserted vertices).
+    pub vertex: u32,
+    /// Distance from the given point (a position, or a face point) to the anchor's vertex.
+    pub distance: f64,
+    /// Whether a vertex was inserted for it.
+    pub inserted: bool,
+}
+
+/// A point anchor row, as resolved (`metrics.json` `anchor_points`).
+#[derive(Debug, Clone, Serialize)]
+pub struct AnchorSnap {
+    pub row: usize,
+    pub source: SideSnap,
+    pub target: SideSnap,
+}
+
+/// A spec whose point anchors became vertex ids, on meshes with the inserted vertices.
+pub struct Resolved {
+    pub spec: JobSpec,
+    pub meshes: Vec<Mesh>,
+    pub snaps: Vec<AnchorSnap>,
+}
+
+fn rows_mut(spec: &mut JobSpec) -> Option<&mut Vec<AnchorRow>> {
+    match spec {
+        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => Some(&mut s.anchors),
+        JobSpec::Homology(s) => Some(&mut s.anchors),
+        JobSpec::Quad(_) => None,
+    }
+}
+
+/// `(face, bary, the given point)` of a point on `mesh`.
+fn locate<'m>(
+    p: &PointRef,
+    row: usize,
+    side: &str,
+    mesh: &'m Mesh,
+    index: &mut Option<SurfaceIndex<'m>>,
+) -> Result<(FaceId, [f64; 3], P3)> {
+    p.check(row, side, mesh.n_faces())?;
+    Ok(match p {
+        PointRef::Face(f) => {
+            let s: f64 = f.bary.iter().map(|b| b.max(0.0)).sum();
+            let w = f.bary.map(|b| b.max(0.0) / s);
+            let [a, b, c] = mesh.faces()[f.face as usize].map(|v| mesh.position(v));
+            (FaceId(f.face as u32), w, P3::from(a.coords * w[0] + b.coords * w[1] + c.coords * w[2]))
+        }
+        PointRef::Position(x) => {
+            if index.is_none() {
+                *index = Some(SurfaceIndex::new(mesh)?);
+            }
+            let n = index.as_ref().map(|i| i.query(&P3::new(x[0], x[1], x[2])));
+            let n = n.ok_or_else(|| crate::Error::Internal("surface index".into()))?;
+            let [a, b, c] = mesh.faces()[n.face.idx()].map(|v| mesh.position(v));
+            let w = barycentric(&n.point, &a, &b, &c).map(|x| x.max(0.0));
+            let s: f64 = w.iter().sum();
+            (n.face, w.map(|x| x / s), P3::new(x[0], x[1], x[2]))
+        }
+    })
+}
+
+/// Resolves the point rows of a pair job; `None` when it has none.
+///
+/// # Errors
+/// `InputError::Anchors` for a malformed point; `InputError::Spec` for a job without two meshes.
+pub fn resolve(spec: &JobSpec, meshes: &[Mesh]) -> Result<Option<Resolved>> {
+    let mut spec = spec.clone();
+    let Some(rows) = rows_mut(&mut spec) else { return Ok(None) };
+    let points: Vec<usize> = (0..rows.len()).filter(|&r| matches!(rows[r], AnchorRow::Points(_))).collect();
+    if points.is_empty() {
+        return Ok(None);
+    }
+    let [s, t] = meshes else {
+        return Err(InputError::Spec(format!("a pair job needs 2 meshes, got {}", meshes.len())).into());
+    };
+    let mut out = Vec::with_capacity(2);
+    let mut sides: Vec<Vec<SideSnap>> = Vec::with_capacity(2);
+    for (k, (mesh, side)) in [(s, "source"), (t, "target")].into_iter().enumerate() {
+        let mut index = None;
+        let mut located = Vec::with_capacity(points.len());
+        for &r in &points {
+            let AnchorRow::Points(p) = &rows[r] else { continue };
+            let p = if k == 0 { &p.source } else { &p.target };
+            located.push(locate(p, r, side, mesh, &mut index)?);
+        }
+        let pts: Vec<(FaceId, [f64; 3])> = located.iter().map(|l| (l.0, l.1)).collect();
+        let ins = insert_points(mesh, &pts, SNAP_TOL * mesh.bbox_diagonal())?;
+        sides.push(
+            located
+                .iter()
+                .zip(ins.vertices.iter().zip(&ins.inserted))
+                .map(|(l, (v, &inserted))| SideSnap {
+                    vertex: v.0,
+                    distance: (ins.mesh.position(*v) - l.2).norm(),
+                    inserted,
+                })
+                .collect(),
+        );
+        out.push(ins.mesh);
+    }
+    let mut snaps = Vec::with_capacity(points.len());
+    for (i, &r) in points.iter().enumerate() {
+        let (a, b) = (sides[0][i].clone(), sides[1][i].clone());
+        rows[r] = AnchorRow::Ids([u64::from(a.vertex), u64::from(b.vertex)]);
+        snaps.push(AnchorSnap { row: r, source: a, target: b });
+    }
+    Ok(Some(Resolved { spec, meshes: out, snaps }))
+}

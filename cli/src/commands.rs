@@ -21,6 +21,10 @@ pub fn inspect(path: &Path) -> Result<String> {
     let s = geom::topology::summary(&r.mesh);
     let mut v = serde_json::to_value(&s).map_err(|e| Error::Internal(e.to_string()))?;
     v["format"] = json!(r.format);
+    if s.components > 1 {
+        v["parts"] =
+            serde_json::to_value(geom::topology::parts(&r.mesh)).map_err(|e| Error::Internal(e.to_string()))?;
+    }
     v["warnings"] = serde_json::to_value(&r.warnings).map_err(|e| Error::Internal(e.to_string()))?;
     let a = r.mesh.attributes();
     v["attributes"] = match &r.layout {

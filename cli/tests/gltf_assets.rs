@@ -97,6 +97,12 @@ fn spot_glb_with_seams_maps_and_morph_keeps_its_layout() {
     let prim = g.meshes().next().unwrap().primitives().next().unwrap();
     assert_eq!(prim.morph_targets().count(), 1);
 
+    // source_on_target.obj keeps spot's UVs and seams (`v/vt` faces, one `vt` per input vertex).
+    let text = std::fs::read_to_string(out.join("source_on_target.obj")).unwrap();
+    assert_eq!(text.lines().filter(|l| l.starts_with("vt ")).count(), 3225);
+    assert_eq!(text.lines().filter(|l| l.starts_with("v ")).count(), 2930);
+    assert!(text.lines().filter(|l| l.starts_with("f ")).all(|l| l.split(' ').skip(1).all(|c| c.contains('/'))));
+
     // target_transferred.glb: the target in its own layout with spot's UVs, seams split.
     let path = out.join("target_transferred.glb");
     let v = khronos_validate(&path);

@@ -50,6 +50,12 @@ fn point_anchors_are_inserted_held_and_reported() {
     let glb = &arts.iter().find(|a| a.name == "morph.glb").unwrap().bytes;
     let m = geom::io::read(glb, &ReadOptions::default()).unwrap();
     assert_eq!(m.mesh.n_vertices(), s.n_vertices());
+    // So do the re-embedded OBJs: the inputs' own faces at the mapped positions.
+    for (name, input) in [("source_on_target.obj", &s), ("target_on_source.obj", &t)] {
+        let obj = &arts.iter().find(|a| a.name == name).unwrap().bytes;
+        let m = geom::io::read(obj, &ReadOptions::default()).unwrap().mesh;
+        assert_eq!(m.faces(), input.faces(), "{name}");
+    }
 }
 
 #[test]

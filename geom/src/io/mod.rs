@@ -19,6 +19,7 @@ mod png16;
 mod stl;
 
 pub use glb_write::{GlbMesh, write_glb, write_glb_mesh, write_layout_glb};
+pub use obj::write_layout as write_obj_layout;
 pub use obj::write_uv_patches as write_obj_uv_patches;
 pub use ply::write_with_face_ints as write_ply_with_face_ints;
 pub use png16::{read_rgb16, write_rgb16};

@@ -294,3 +294,36 @@ pub fn write_uv_patches(patches: &[(&Mesh, &[[f64; 2]])]) -> Vec<u8> {
     }
     out
 }
+
+/// Writes OBJ in an input's own layout: one `v` per welded vertex (`positions`), `vt` / `vn`
+/// per input vertex (its first UV set and normals, when it has them) and faces `v/vt/vn`.
+pub fn write_layout(positions: &[crate::mesh::P3], layout: &InputLayout) -> Vec<u8> {
+    use std::io::Write;
+    let mut out = Vec::with_capacity(positions.len() * 48 + layout.triangles.len() * 32);
+    for p in positions {
+        let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+    }
+    let uv = layout.attributes.texcoords.first();
+    for t in uv.into_iter().flatten() {
+        let _ = writeln!(out, "vt {} {}", t[0], t[1]);
+    }
+    let nrm = layout.attributes.normals.as_ref();
+    for n in nrm.into_iter().flatten() {
+        let _ = writeln!(out, "vn {} {} {}", n[0], n[1], n[2]);
+    }
+    for t in &layout.triangles {
+        let _ = write!(out, "f");
+        for &i in t {
+            let v = layout.welded[i as usize] + 1;
+            let i = i + 1;
+            let _ = match (uv.is_some(), nrm.is_some()) {
+                (false, false) => write!(out, " {v}"),
+                (true, false) => write!(out, " {v}/{i}"),
+                (false, true) => write!(out, " {v}//{i}"),
+                (true, true) => write!(out, " {v}/{i}/{i}"),
+            };
+        }
+        let _ = writeln!(out);
+    }
+    out
+}

@@ -156,6 +156,7 @@ pub fn run_with_layouts(
     }
     folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
     layout_outputs::add_morph(&report, originals, meshes, &layouts, &mut arts);
+    layout_outputs::rewrite_objs(&report, originals, meshes, &layouts, &mut arts);
     if wants_transfer {
         transfer_output::add(&report, &transfer, (originals, meshes), &layouts, &mut arts)?;
     }

@@ -6,7 +6,7 @@ mod locate;
 mod loops;
 mod surface_point;
 
-pub use components::{Components, components};
+pub use components::{Components, PartSummary, components, parts};
 pub use locate::{Locator, Projection};
 pub use loops::boundary_loops;
 pub use surface_point::SurfacePoint;

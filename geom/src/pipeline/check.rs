@@ -47,7 +47,7 @@ impl LayoutSpec {
     /// # Errors
     /// `InputError::TopologyMismatch`, `InputError::Anchors`, `InputError::OptionRange`.
     pub fn check(&self, method: Method, ss: &Summary, ts: &Summary) -> Result<Vec<(VertexId, VertexId)>> {
-        same_topology(ss, ts)?;
+        same_topology(ss, ts, true)?;
         if ss.boundary_loops != 0 {
             return Err(InputError::TopologyMismatch(format!(
                 "method {} maps closed surfaces; source has {} boundary loops, target {} (method homology maps genus-0 surfaces with boundaries)",
@@ -80,7 +80,7 @@ impl HomologySpec {
     /// `InputError::TopologyMismatch`, `InputError::Anchors`, `InputError::Features`,
     /// `InputError::OptionRange`.
     pub fn check(&self, ss: &Summary, ts: &Summary) -> Result<Vec<(VertexId, VertexId)>> {
-        same_topology(ss, ts)?;
+        same_topology(ss, ts, self.features.is_empty())?;
         if ss.boundary_loops > 0 && ss.genus > 0 {
             return Err(InputError::TopologyMismatch(format!(
                 "boundary loops are supported on genus-0 surfaces (features on closed surfaces of any genus); these have genus {} and {} boundary loops",
@@ -140,11 +140,15 @@ impl HomologySpec {
 }
 
 /// Both meshes connected, of one genus and one number of boundary loops.
-fn same_topology(ss: &Summary, ts: &Summary) -> Result<()> {
-    if ss.components != 1 || ts.components != 1 {
+/// Equal genus and boundary counts; one part each, or (`parts_ok`: a job `pipeline::parts`
+/// runs part by part) as many parts on both.
+fn same_topology(ss: &Summary, ts: &Summary, parts_ok: bool) -> Result<()> {
+    if ss.components != ts.components || (!parts_ok && ss.components != 1) {
         return Err(InputError::TopologyMismatch(format!(
-            "both meshes must be connected (source has {} components, target {})",
-            ss.components, ts.components
+            "the source has {} parts (connected components), the target {}: {}",
+            ss.components,
+            ts.components,
+            if parts_ok { "parts map one to one" } else { "this job maps connected meshes (voronoi, greedy and homology without feature curves map several parts, pairing them through the anchors)" }
         ))
         .into());
     }

@@ -19,6 +19,7 @@ mod layout_outputs;
 mod limits;
 mod memory;
 mod optimize;
+pub mod parts;
 pub mod quad;
 mod quad_spec;
 mod ranges;
@@ -49,6 +50,8 @@ pub enum JobReport {
     Homology(homology::HomologyMapReport),
     Features(features::FeatureMapReport),
     Quad(QuadReport),
+    /// A pair job on meshes in several parts.
+    Parts(Box<parts::PartsReport>),
 }
 
 impl JobReport {
@@ -58,6 +61,7 @@ impl JobReport {
             JobReport::Layout(r) => Some(&r.pair),
             JobReport::Homology(r) => Some(&r.pair),
             JobReport::Features(r) => Some(&r.pair),
+            JobReport::Parts(r) => Some(&r.pair),
             JobReport::Quad(_) => None,
         }
     }
@@ -68,6 +72,7 @@ impl JobReport {
             JobReport::Layout(r) => Some(&mut r.pair),
             JobReport::Homology(r) => Some(&mut r.pair),
             JobReport::Features(r) => Some(&mut r.pair),
+            JobReport::Parts(r) => Some(&mut r.pair),
             JobReport::Quad(_) => None,
         }
     }
@@ -120,6 +125,25 @@ pub fn run_with_layouts(
         Some(r) => (&r.spec, r.meshes.as_slice()),
         None => (spec, meshes),
     };
+    let (mut report, mut arts) = match parts::run(spec, meshes, progress)? {
+        Some(whole) => whole,
+        None => dispatch(spec, meshes, progress)?,
+    };
+    if let (Some(r), Some(pair)) = (&resolved, report.pair_mut()) {
+        pair.anchor_points = r.snaps.clone();
+        arts.retain(|a| a.name != "metrics.json");
+        arts.push(common::json_artifact("metrics.json", &report)?);
+    }
+    folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
+    layout_outputs::add_morph(&report, originals, meshes, &layouts, &mut arts);
+    layout_outputs::rewrite_objs(&report, originals, meshes, &layouts, &mut arts);
+    if wants_transfer {
+        transfer_output::add(&report, &transfer, (originals, meshes), &layouts, &mut arts)?;
+    }
+    Ok((report, arts))
+}
+/// One pipeline per method.
+fn dispatch(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Result<(JobReport, Vec<Artifact>)> {
     let pair = || match meshes {
         [s, t] => Ok((s, t)),
         _ => Err(InputError::Spec(format!(
@@ -128,7 +152,7 @@ pub fn run_with_layouts(
             meshes.len()
         ))),
     };
-    let (mut report, mut arts) = match spec {
+    Ok(match spec {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => {
             let (a, b) = pair()?;
             let (r, arts) = voronoi::run(spec.method(), s, a, b, progress)?;
@@ -148,20 +172,9 @@ pub fn run_with_layouts(
             let (r, arts) = quad::run(s, meshes, progress)?;
             (JobReport::Quad(r), arts)
         }
-    };
-    if let (Some(r), Some(pair)) = (&resolved, report.pair_mut()) {
-        pair.anchor_points = r.snaps.clone();
-        arts.retain(|a| a.name != "metrics.json");
-        arts.push(common::json_artifact("metrics.json", &report)?);
-    }
-    folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
-    layout_outputs::add_morph(&report, originals, meshes, &layouts, &mut arts);
-    layout_outputs::rewrite_objs(&report, originals, meshes, &layouts, &mut arts);
-    if wants_transfer {
-        transfer_output::add(&report, &transfer, (originals, meshes), &layouts, &mut arts)?;
-    }
-    Ok((report, arts))
+    })
 }
+
 #[cfg(test)]
 mod cancel_tests {
     use super::*;

@@ -50,6 +50,11 @@ fn malformed_inputs_exit_2_with_a_named_problem() {
         ("duplicate.off", b"OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 1 2 0\n".to_vec(), "duplicate_face"),
         ("noface.obj", b"v 0 0 0\nv 1 0 0\n".to_vec(), "no_faces"),
         ("huge_count.off", b"OFF\n99999999999 1 0\n".to_vec(), "too_large"),
+        // glTF: a GLB header promising more bytes than the file, a Draco-only document, an
+        // accessor reading past its buffer.
+        ("lying.glb", { let mut b = b"glTF".to_vec(); b.extend_from_slice(&2u32.to_le_bytes()); b.extend_from_slice(&5000u32.to_le_bytes()); b.extend_from_slice(&[0u8; 20]); b }, "lying_count"),
+        ("draco.gltf", br#"{"asset": {"version": "2.0"}, "extensionsUsed": ["KHR_draco_mesh_compression"], "extensionsRequired": ["KHR_draco_mesh_compression"], "meshes": []}"#.to_vec(), "unsupported_extension"),
+        ("past_buffer.gltf", br#"{"asset": {"version": "2.0"}, "buffers": [{"byteLength": 12, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAA"}], "bufferViews": [{"buffer": 0, "byteLength": 12}], "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}]}"#.to_vec(), "lying_count"),
     ];
     let mut wrong = Vec::new();
     for (name, bytes, code) in cases {

@@ -4,14 +4,14 @@
 mod common;
 use geom::io::ReadOptions;
 use geom::map::transfer::{SourceField, TransferOptions, transfer};
-use geom::metrics::SurfaceIndex;
+use geom::topology::Locator;
 
 #[test]
 fn an_exact_map_carries_uvs_exactly_and_splits_the_seams() {
     let obj = std::fs::read(common::shared_mesh("spot.obj")).unwrap();
     let r = geom::io::read(&obj, &ReadOptions::default()).unwrap();
     let lay = r.layout.as_ref().unwrap();
-    let field = SourceField { mesh: &r.mesh, layout: Some(lay), index: SurfaceIndex::new(&r.mesh).unwrap() };
+    let field = SourceField { mesh: &r.mesh, layout: Some(lay), locator: Locator::new(&r.mesh).unwrap() };
     let images = r.mesh.positions().to_vec();
     let o = TransferOptions { texcoords: vec![0], ..Default::default() };
     let t = transfer(&field, &r.mesh, None, &images, &o).unwrap();

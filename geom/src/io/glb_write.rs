@@ -165,24 +165,9 @@ pub fn write_layout_glb(mesh: &crate::Mesh, layout: Option<&InputLayout>, target
             })
         }
         None => {
-            let a = mesh.attributes();
-            let attributes = Attributes {
-                normals: a.normals.as_ref().map(|n| n.iter().map(|v| [v.x as f32, v.y as f32, v.z as f32]).collect()),
-                texcoords: a.uvs.iter().map(|t| t.iter().map(|u| [u[0] as f32, u[1] as f32]).collect()).collect(),
-                color: a.colors.as_ref().map(|c| c.iter().map(|c| linear_rgba(*c)).collect()),
-                ..Default::default()
-            };
+            let attributes = Attributes::from(mesh.attributes());
             let tris: Vec<[u32; 3]> = mesh.faces().iter().map(|f| f.map(|v| v.0)).collect();
             write_glb_mesh(&GlbMesh { positions: mesh.positions(), triangles: &tris, attributes: &attributes, targets })
         }
     }
-}
-
-/// An sRGB byte colour as glTF's linear `COLOR_0` (alpha stays linear).
-fn linear_rgba(c: [u8; 4]) -> [f32; 4] {
-    let lin = |x: u8| {
-        let s = f32::from(x) / 255.0;
-        if s <= 0.04045 { s / 12.92 } else { ((s + 0.055) / 1.055).powf(2.4) }
-    };
-    [lin(c[0]), lin(c[1]), lin(c[2]), f32::from(c[3]) / 255.0]
 }

@@ -12,7 +12,7 @@
 use crate::error::Result;
 use crate::mesh::insert::barycentric;
 use crate::mesh::{Attributes, FaceId, InputLayout, Mesh, P3};
-use crate::metrics::SurfaceIndex;
+use crate::topology::Locator;
 use std::collections::HashMap;
 
 /// Which attributes to carry (glTF names).
@@ -37,7 +37,7 @@ pub struct TransferResult {
 pub struct SourceField<'a> {
     pub mesh: &'a Mesh,
     pub layout: Option<&'a InputLayout>,
-    pub index: SurfaceIndex<'a>,
+    pub locator: Locator,
 }
 
 /// Smooth values of one corner: UV sets then RGBA, flattened.
@@ -89,9 +89,8 @@ impl SourceField<'_> {
 
     /// `(face, bary)` of a point of the surface.
     fn locate(&self, p: &P3) -> (FaceId, [f64; 3]) {
-        let n = self.index.query(p);
-        let [a, b, c] = self.mesh.faces()[n.face.idx()].map(|v| self.mesh.position(v));
-        (n.face, barycentric(&n.point, &a, &b, &c))
+        let pr = self.locator.project(p);
+        (pr.face, pr.bary)
     }
 }
 
@@ -113,7 +112,7 @@ pub fn transfer(
     images: &[P3],
     o: &TransferOptions,
 ) -> Result<TransferResult> {
-    let a = src.layout.map_or_else(|| mesh_attributes(src.mesh), |l| l.attributes.clone());
+    let a = src.layout.map_or_else(|| Attributes::from(src.mesh.attributes()), |l| l.attributes.clone());
     let (t_tris, t_welded): (Vec<[u32; 3]>, Vec<u32>) = match target_layout {
         Some(l) => (l.triangles.clone(), l.welded.clone()),
         None => (target.face_indices(), (0..target.n_vertices() as u32).collect()),
@@ -175,7 +174,8 @@ pub fn transfer(
     for c in copies.iter().flatten() {
         smooth_out[c.1 as usize] = c.0.clone();
     }
-    let mut attrs = target_layout.map_or_else(|| mesh_attributes(target), |l| l.attributes.clone()).select(&origin);
+    let mut attrs =
+        target_layout.map_or_else(|| Attributes::from(target.attributes()), |l| l.attributes.clone()).select(&origin);
     let mut d = 0;
     for slot in 0..o.texcoords.len() {
         let uv: Vec<[f32; 2]> = smooth_out
@@ -208,15 +208,4 @@ pub fn transfer(
         attrs.weights = Some(w);
     }
     Ok(TransferResult { positions, triangles, attributes: attrs, split_vertices: n_out - n_in })
-}
-
-/// A mesh's own per-vertex attributes in the asset form.
-pub fn mesh_attributes(m: &Mesh) -> Attributes {
-    let a = m.attributes();
-    Attributes {
-        normals: a.normals.as_ref().map(|n| n.iter().map(|v| [v.x as f32, v.y as f32, v.z as f32]).collect()),
-        texcoords: a.uvs.iter().map(|t| t.iter().map(|u| [u[0] as f32, u[1] as f32]).collect()).collect(),
-        color: a.colors.as_ref().map(|c| c.iter().map(|c| c.map(|x| f32::from(x) / 255.0)).collect()),
-        ..Default::default()
-    }
 }

@@ -26,6 +26,25 @@ pub struct Attributes {
     pub weights: Option<Vec<[f32; 4]>>,
 }
 
+impl From<&super::VertexAttributes> for Attributes {
+    /// A mesh's own per-vertex attributes in asset form (colours as glTF's linear RGBA).
+    fn from(a: &super::VertexAttributes) -> Self {
+        let lin = |x: u8| {
+            let s = f32::from(x) / 255.0;
+            if s <= 0.04045 { s / 12.92 } else { ((s + 0.055) / 1.055).powf(2.4) }
+        };
+        Attributes {
+            normals: a.normals.as_ref().map(|n| n.iter().map(|v| [v.x as f32, v.y as f32, v.z as f32]).collect()),
+            texcoords: a.uvs.iter().map(|t| t.iter().map(|u| [u[0] as f32, u[1] as f32]).collect()).collect(),
+            color: a
+                .colors
+                .as_ref()
+                .map(|c| c.iter().map(|c| [lin(c[0]), lin(c[1]), lin(c[2]), f32::from(c[3]) / 255.0]).collect()),
+            ..Default::default()
+        }
+    }
+}
+
 impl Attributes {
     /// Whether no attribute is present.
     pub fn is_empty(&self) -> bool {

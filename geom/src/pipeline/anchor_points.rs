@@ -1,15 +1,14 @@
 //! Anchor rows given as surface points become vertex ids before a method runs: a position is
-//! snapped to the nearest point of the surface (exact closest point on a triangle, through the
-//! metrics' BVH), a face point is taken as given; within 1e-9 of the bounding-box diagonal of a
+//! snapped to the nearest point of the surface (`topology::Locator`), a face point is taken as given; within 1e-9 of the bounding-box diagonal of a
 //! vertex (or 1% of the face's shortest edge, so no sliver is made) the anchor is that vertex,
 //! else a vertex is inserted there (`mesh::insert`). Each snap's distance is reported.
 
 use super::anchor_spec::{AnchorRow, PointRef};
 use super::spec::JobSpec;
 use crate::error::{InputError, Result};
-use crate::mesh::insert::{barycentric, insert_points};
+use crate::mesh::insert::insert_points;
 use crate::mesh::{FaceId, Mesh, P3};
-use crate::metrics::SurfaceIndex;
+use crate::topology::Locator;
 use serde::Serialize;
 
 /// Relative snapping tolerance (of the bounding-box diagonal).
@@ -50,12 +49,12 @@ fn rows_mut(spec: &mut JobSpec) -> Option<&mut Vec<AnchorRow>> {
 }
 
 /// `(face, bary, the given point)` of a point on `mesh`.
-fn locate<'m>(
+fn locate(
     p: &PointRef,
     row: usize,
     side: &str,
-    mesh: &'m Mesh,
-    index: &mut Option<SurfaceIndex<'m>>,
+    mesh: &Mesh,
+    locator: &mut Option<Locator>,
 ) -> Result<(FaceId, [f64; 3], P3)> {
     p.check(row, side, mesh.n_faces())?;
     Ok(match p {
@@ -66,15 +65,15 @@ fn locate<'m>(
             (FaceId(f.face as u32), w, P3::from(a.coords * w[0] + b.coords * w[1] + c.coords * w[2]))
         }
         PointRef::Position(x) => {
-            if index.is_none() {
-                *index = Some(SurfaceIndex::new(mesh)?);
+            if locator.is_none() {
+                *locator = Some(Locator::new(mesh)?);
             }
-            let n = index.as_ref().map(|i| i.query(&P3::new(x[0], x[1], x[2])));
-            let n = n.ok_or_else(|| crate::Error::Internal("surface index".into()))?;
-            let [a, b, c] = mesh.faces()[n.face.idx()].map(|v| mesh.position(v));
-            let w = barycentric(&n.point, &a, &b, &c).map(|x| x.max(0.0));
+            let given = P3::new(x[0], x[1], x[2]);
+            let pr = locator.as_ref().map(|l| l.project(&given));
+            let pr = pr.ok_or_else(|| crate::Error::Internal("surface locator".into()))?;
+            let w = pr.bary.map(|x| x.max(0.0));
             let s: f64 = w.iter().sum();
-            (n.face, w.map(|x| x / s), P3::new(x[0], x[1], x[2]))
+            (pr.face, w.map(|x| x / s), given)
         }
     })
 }
@@ -96,12 +95,12 @@ pub fn resolve(spec: &JobSpec, meshes: &[Mesh]) -> Result<Option<Resolved>> {
     let mut out = Vec::with_capacity(2);
     let mut sides: Vec<Vec<SideSnap>> = Vec::with_capacity(2);
     for (k, (mesh, side)) in [(s, "source"), (t, "target")].into_iter().enumerate() {
-        let mut index = None;
+        let mut locator = None;
         let mut located = Vec::with_capacity(points.len());
         for &r in &points {
             let AnchorRow::Points(p) = &rows[r] else { continue };
             let p = if k == 0 { &p.source } else { &p.target };
-            located.push(locate(p, r, side, mesh, &mut index)?);
+            located.push(locate(p, r, side, mesh, &mut locator)?);
         }
         let pts: Vec<(FaceId, [f64; 3])> = located.iter().map(|l| (l.0, l.1)).collect();
         let ins = insert_points(mesh, &pts, SNAP_TOL * mesh.bbox_diagonal())?;

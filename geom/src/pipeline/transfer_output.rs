@@ -5,9 +5,9 @@ use super::JobReport;
 use super::common::Artifact;
 use crate::error::{InputError, Result};
 use crate::io;
-use crate::map::transfer::{SourceField, TransferOptions, mesh_attributes, transfer};
+use crate::map::transfer::{SourceField, TransferOptions, transfer};
 use crate::mesh::{Attributes, InputLayout, Mesh, P3, VertexId};
-use crate::metrics::SurfaceIndex;
+use crate::topology::Locator;
 
 /// The attributes a job may carry.
 pub const TRANSFERABLE: &str =
@@ -42,7 +42,7 @@ pub fn parse(names: &[String]) -> Result<TransferOptions> {
 }
 
 fn source_attributes(source: &Mesh, layout: Option<&InputLayout>) -> Attributes {
-    layout.map_or_else(|| mesh_attributes(source), |l| l.attributes.clone())
+    layout.map_or_else(|| Attributes::from(source.attributes()), |l| l.attributes.clone())
 }
 
 /// Checks the source has every attribute asked for.
@@ -71,7 +71,7 @@ pub fn check_source(o: &TransferOptions, source: &Mesh, layout: Option<&InputLay
 /// Adds `target_transferred.glb` (nothing for a job without maps, or with a withheld direction).
 ///
 /// # Errors
-/// `Internal` if the surface index cannot be built.
+/// `Internal` if the surface locator cannot be built.
 pub fn add(
     report: &JobReport,
     o: &TransferOptions,
@@ -83,7 +83,7 @@ pub fn add(
     let Some(maps) = pair.maps.as_ref().filter(|_| pair.withheld.is_empty()) else { return Ok(()) };
     let images: Vec<P3> = (0..target.n_vertices()).map(|v| maps.t2s.position(VertexId(v as u32), src_run)).collect();
     let field =
-        SourceField { mesh: source, layout: layouts.first().copied().flatten(), index: SurfaceIndex::new(source)? };
+        SourceField { mesh: source, layout: layouts.first().copied().flatten(), locator: Locator::new(source)? };
     let r = transfer(&field, target, layouts.get(1).copied().flatten(), &images, o)?;
     let bytes = io::write_glb_mesh(&io::GlbMesh {
         positions: &r.positions,

@@ -19,8 +19,11 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("map");
     g.sample_size(10);
     for method in [Method::Voronoi, Method::Greedy] {
-        let spec =
-            LayoutSpec { anchors: geom::pipeline::AnchorRow::ids(anchors.clone()), options: MapOptions::default() };
+        let spec = LayoutSpec {
+            boundaries: Vec::new(),
+            anchors: geom::pipeline::AnchorRow::ids(anchors.clone()),
+            options: MapOptions::default(),
+        };
         g.bench_function(format!("armadillo_bent_45_{}", method.name()), |b| {
             b.iter(|| run_map(method, &spec, &s, &t, &mut NoProgress).expect("map"))
         });
@@ -34,7 +37,11 @@ fn bench(c: &mut Criterion) {
             .expect("decimate");
     let anchors: Vec<[u64; 2]> =
         fps(&coarse.mesh, 45).into_iter().map(|a| [u64::from(coarse.kept[a as usize].0), a]).collect();
-    let spec = LayoutSpec { anchors: geom::pipeline::AnchorRow::ids(anchors), options: MapOptions::default() };
+    let spec = LayoutSpec {
+        boundaries: Vec::new(),
+        anchors: geom::pipeline::AnchorRow::ids(anchors),
+        options: MapOptions::default(),
+    };
     g.bench_function("armadillo_58k_vs_6k_45_voronoi", |b| {
         b.iter(|| run_map(Method::Voronoi, &spec, &fine, &coarse.mesh, &mut NoProgress).expect("map"))
     });

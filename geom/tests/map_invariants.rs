@@ -45,6 +45,7 @@ fn check_with(
 ) -> Checked {
     let anchors: Vec<[u64; 2]> = fps(s, k).into_iter().map(|a| [a as u64, gt[a as usize] as u64]).collect();
     let spec = LayoutSpec {
+        boundaries: Vec::new(),
         anchors: geom::pipeline::AnchorRow::ids(anchors.clone()),
         options: MapOptions { metric_samples: 5000, ..options },
     };

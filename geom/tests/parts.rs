@@ -30,6 +30,7 @@ fn a_two_part_mesh_maps_part_by_part() {
         common::fps(&torus, 12).into_iter().map(|a| [u64::from(a), u64::from(a)]).collect();
     anchors.extend([0u64, 7, 19, 33].iter().map(|&k| [n + k, n + k]));
     let spec = JobSpec::Voronoi(LayoutSpec {
+        boundaries: Vec::new(),
         anchors: AnchorRow::ids(anchors.clone()),
         options: MapOptions { metric_samples: 5000, ..Default::default() },
     });
@@ -56,6 +57,7 @@ fn a_two_part_mesh_maps_part_by_part() {
 
     // Without anchors on the sphere: the error names it.
     let spec = JobSpec::Voronoi(LayoutSpec {
+        boundaries: Vec::new(),
         anchors: AnchorRow::ids(anchors[..12].to_vec()),
         options: MapOptions::default(),
     });

@@ -242,7 +242,7 @@ pub fn complete(
             };
             let victim = sides
                 .into_iter()
-                .filter(|&p| ripped.iter().filter(|&&q| q == pair(p)).count() < MAX_RIPS_PER_PAIR)
+                .filter(|&p| !t0.is_fixed(p) && ripped.iter().filter(|&&q| q == pair(p)).count() < MAX_RIPS_PER_PAIR)
                 // Never a bridge or an anchor's last path: the layout must stay connected.
                 .filter(|&p| !disconnects(t0, p))
                 .min_by(|&x, &y| t0.paths()[x as usize].length.total_cmp(&t0.paths()[y as usize].length));

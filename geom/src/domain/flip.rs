@@ -149,7 +149,7 @@ pub fn flip_paths(
         for p in 0..st.paths().len() as u32 {
             progress.check()?;
             let (a, b) = (st.paths()[p as usize].a, st.paths()[p as usize].b);
-            if st.rotation(a).len() <= 3 || st.rotation(b).len() <= 3 {
+            if st.is_fixed(p) || st.rotation(a).len() <= 3 || st.rotation(b).len() <= 3 {
                 continue;
             }
             let (Some((s_sum, c, d, w1, w2)), Some((t_sum, c2, d2, tw1, tw2))) =

@@ -26,7 +26,7 @@ fn pair_lengths(t: &Tracer) -> Result<Vec<Vec<f64>>> {
     Ok(out)
 }
 
-/// Builds the layouts on both tracers (which must hold no paths).
+/// Builds the layouts on both tracers (which must hold the same fixed paths and no others).
 ///
 /// # Errors
 /// `InputError::LayoutConflict` when no consistent triangulation is found; `Cancelled`.
@@ -58,6 +58,9 @@ pub fn greedy_layout<'m>(
         }
         if src.paths().len() >= max_paths || super::walks::is_complete(src, chi) {
             break;
+        }
+        if src.is_enclosed(a) || src.is_enclosed(b) || src.linked_by_fixed(a, b) {
+            continue;
         }
         let Some(ps) = src.trace(&TraceRequest { a, b, ..Default::default() })? else {
             stats.failed_traces += 1;

@@ -9,6 +9,7 @@ pub mod complete;
 pub mod cuts;
 pub mod flip;
 pub mod greedy;
+pub mod loops;
 pub mod refine;
 pub mod straighten;
 pub mod tracer;

@@ -52,6 +52,10 @@ pub struct Tracer<'m> {
     /// Per anchor: its ring nodes sorted by key.
     rings: Vec<Vec<(NodeId, u32)>>,
     opts: EdgeNodeOptions,
+    /// Paths `0..fixed` were given ([`Tracer::fix`]): never re-traced, flipped or removed.
+    fixed: u32,
+    /// Faces no traced path may cross (the inside of a cap, already split by fixed paths).
+    closed: Vec<bool>,
 }
 
 struct Filter<'a, 't> {
@@ -89,7 +93,7 @@ impl SearchFilter for Filter<'_, '_> {
         !self.t.used[i] && !self.t.tmp_block[i] && (i >= self.t.anchor_of.len() || self.t.anchor_of[i] == u32::MAX)
     }
     fn face_ok(&self, f: FaceId) -> bool {
-        self.faces.is_none_or(|m| m[f.idx()])
+        !self.t.closed[f.idx()] && self.faces.is_none_or(|m| m[f.idx()])
     }
     fn arc_ok(&self, face: Option<FaceId>, from: NodeId, to: NodeId) -> bool {
         let Some(f) = face else { return true };
@@ -190,7 +194,61 @@ impl<'m> Tracer<'m> {
             ring_owner,
             rings,
             opts: *opts,
+            fixed: 0,
+            closed: vec![false; mesh.n_faces()],
         })
+    }
+
+    /// Gives the tracer its fixed paths (inserted as paths `0..paths.len()`, in order) and the
+    /// faces no later path may cross. Must come before any other path.
+    ///
+    /// # Errors
+    /// `Error::Internal` when paths exist already or a fixed path is not a chain of arcs.
+    pub fn fix(&mut self, paths: Vec<LayoutPath>, closed: &[FaceId]) -> Result<()> {
+        if !self.paths.is_empty() {
+            return Err(Error::Internal("fixed paths must come first".into()));
+        }
+        for p in paths {
+            self.insert(p)?;
+        }
+        self.fixed = self.paths.len() as u32;
+        for f in closed {
+            self.closed[f.idx()] = true;
+        }
+        Ok(())
+    }
+
+    /// A tracer on the same mesh, anchors and options holding only the fixed paths.
+    ///
+    /// # Errors
+    /// As [`Tracer::new`] and [`Tracer::fix`].
+    pub fn fresh(&self) -> Result<Tracer<'m>> {
+        let mut t = Tracer::new(self.mesh(), &self.anchors, &self.opts)?;
+        let closed: Vec<FaceId> =
+            self.closed.iter().enumerate().filter(|x| *x.1).map(|(f, _)| FaceId::from_idx(f)).collect();
+        t.fix(self.paths[..self.fixed as usize].to_vec(), &closed)?;
+        Ok(t)
+    }
+
+    /// Number of fixed paths (they are paths `0..n`).
+    pub fn n_fixed(&self) -> u32 {
+        self.fixed
+    }
+
+    /// Was path `id` given as fixed?
+    pub fn is_fixed(&self, id: u32) -> bool {
+        id < self.fixed
+    }
+
+    /// Is the anchor pair `{a, b}` joined by a fixed path?
+    pub fn linked_by_fixed(&self, a: u32, b: u32) -> bool {
+        self.paths[..self.fixed as usize].iter().any(|p| (p.a == a && p.b == b) || (p.a == b && p.b == a))
+    }
+
+    /// Does anchor `a` lie inside closed faces only (a cap's apex, which no traced path reaches)?
+    pub fn is_enclosed(&self, a: u32) -> bool {
+        let m = self.mesh();
+        m.vertex_faces(self.anchors[a as usize]).all(|f| self.closed[f.idx()])
     }
 
     /// The edge-node options the graph was built with.
@@ -380,6 +438,7 @@ impl<'m> Tracer<'m> {
 
     /// Deletes path `id`; the last path takes its index.
     pub fn remove(&mut self, id: u32) {
+        debug_assert!(!self.is_fixed(id), "fixed paths are never removed");
         let _ = self.lift(id);
         let last = self.paths.len() as u32 - 1;
         if id != last {
@@ -400,6 +459,9 @@ impl<'m> Tracer<'m> {
     /// # Errors
     /// `Error::Internal` if the old path cannot be put back.
     pub fn retrace(&mut self, id: u32) -> Result<bool> {
+        if self.is_fixed(id) {
+            return Ok(false);
+        }
         let old = self.paths[id as usize].clone();
         let (sector_a, sector_b) = self.lift(id);
         let req = TraceRequest { a: old.a, b: old.b, sector_a, sector_b, ..Default::default() };
@@ -430,6 +492,9 @@ impl<'m> Tracer<'m> {
         sector_a: Sector,
         sector_b: Sector,
     ) -> Result<Option<LayoutPath>> {
+        if self.is_fixed(id) {
+            return Ok(None);
+        }
         let old = self.paths[id as usize].clone();
         let _ = self.lift(id);
         let req = TraceRequest { a, b, sector_a: Some(sector_a), sector_b: Some(sector_b), ..Default::default() };

@@ -58,7 +58,7 @@ fn anchor_dist(m: &Mesh, anchors: &[VertexId], a: u32, b: u32) -> f64 {
     (m.position(anchors[a as usize]) - m.position(anchors[b as usize])).norm()
 }
 
-/// Builds the source layout on `t` (which must hold no paths yet).
+/// Builds the source layout on `t` (which must hold no paths yet but its fixed ones).
 ///
 /// # Errors
 /// `InputError::LayoutConflict` when the layout cannot be completed; `Cancelled`.
@@ -84,6 +84,11 @@ pub fn source_layout(
         progress.check()?;
         progress.report(crate::progress::Stage::LayoutSource, 0.8 * k as f64 / order.len().max(1) as f64);
         let c = &cl.cuts[ci];
+        // A cap's apex is linked by its fixed spokes only, and a pair a fixed path joins
+        // already (along a boundary loop) gets no second path.
+        if t.is_enclosed(c.i) || t.is_enclosed(c.j) || t.linked_by_fixed(c.i, c.j) {
+            continue;
+        }
         let mask = cl.mask(c.i, c.j);
         let blocked = blocked_for_cut(t, &cl, ci);
         let req = TraceRequest { a: c.i, b: c.j, faces: Some(&mask), blocked: &blocked, ..Default::default() };
@@ -182,7 +187,8 @@ fn present_interval(src: &Tracer, tid: &[Option<u32>], x: u32, hs: Half) -> (Opt
     (pred, succ)
 }
 
-/// Builds the target layout as a copy of the source's on `tgt` (which must hold no paths),
+/// Builds the target layout as a copy of the source's on `tgt` (which must hold the source's
+/// fixed paths and no others),
 /// then renumbers its paths to the source's numbering.
 ///
 /// # Errors
@@ -199,9 +205,14 @@ pub fn target_layout(
     let cl = clusters(tgt.mesh(), &anchors)?;
     let np = src.paths().len();
     let order = PathOrder::new(src, &cl, priority);
-    let mut queue = order.queue(src);
-    let mut tid: Vec<Option<u32>> = vec![None; np];
-    let mut sid: Vec<u32> = Vec::with_capacity(np);
+    // Fixed paths are on both meshes already, under the same numbers.
+    let nf = src.n_fixed();
+    if tgt.n_fixed() != nf || tgt.paths().len() as u32 != nf {
+        return Err(crate::error::Error::Internal("the target tracer must hold the source's fixed paths only".into()));
+    }
+    let mut queue: Vec<usize> = order.queue(src).into_iter().filter(|&s| s as u32 >= nf).collect();
+    let mut tid: Vec<Option<u32>> = (0..np as u32).map(|s| (s < nf).then_some(s)).collect();
+    let mut sid: Vec<u32> = (0..nf).collect();
     let mut stats = LayoutStats { cuts: cl.cuts.len(), ..Default::default() };
     let mut attempts = 0usize;
     let mut force = false;
@@ -398,7 +409,7 @@ pub fn target_layout_with_restarts<'m>(
 ) -> Result<LayoutStats> {
     let mut priority: Vec<usize> = Vec::new();
     loop {
-        let mut fresh = Tracer::new(tgt.mesh(), tgt.anchors(), &tgt.edge_node_options())?;
+        let mut fresh = tgt.fresh()?;
         match target_layout(src, src_clusters, &mut fresh, opts, &priority, progress)? {
             Ok(mut s) => {
                 s.postponed += priority.len();

@@ -7,6 +7,7 @@
 //! [`Mesh::from_raw`] refuses or repairs (with a warning) anything else.
 
 mod build;
+pub mod cap;
 pub mod cut;
 mod cut_copy;
 mod ids;

@@ -41,24 +41,40 @@ impl JobSpec {
 }
 
 impl LayoutSpec {
-    /// Closed connected meshes of one genus, options in range, enough anchors (3 on genus 0,
-    /// 6 above), in range and distinct. Returns the anchors as vertex pairs.
+    /// Meshes of one genus and boundary count, options in range, `boundaries` rows in range,
+    /// enough anchors (3 on a closed genus-0 surface, 1 on an open one, 6 above), in range and
+    /// distinct. Returns the anchors as vertex pairs.
     ///
     /// # Errors
     /// `InputError::TopologyMismatch`, `InputError::Anchors`, `InputError::OptionRange`.
     pub fn check(&self, method: Method, ss: &Summary, ts: &Summary) -> Result<Vec<(VertexId, VertexId)>> {
         same_topology(ss, ts, true)?;
-        if ss.boundary_loops != 0 {
-            return Err(InputError::TopologyMismatch(format!(
-                "method {} maps closed surfaces; source has {} boundary loops, target {} (method homology maps genus-0 surfaces with boundaries)",
-                method.name(),
-                ss.boundary_loops,
-                ts.boundary_loops
+        self.options.check_ranges()?;
+        if self.boundaries.len() > ss.boundary_loops {
+            return Err(InputError::Anchors(format!(
+                "{} boundaries rows, but the meshes have {} boundary loops",
+                self.boundaries.len(),
+                ss.boundary_loops
             ))
             .into());
         }
-        self.options.check_ranges()?;
-        let need = if ss.genus == 0 { 3 } else { 6 };
+        for (i, &[s, t]) in self.boundaries.iter().enumerate() {
+            if s >= ss.id_count() as u64 || t >= ts.id_count() as u64 {
+                return Err(InputError::Anchors(format!(
+                    "boundaries row {i}: vertex out of range (source has {}, target {} vertices)",
+                    ss.id_count(),
+                    ts.id_count()
+                ))
+                .into());
+            }
+        }
+        // A loop's own anchors (added along it) and its cone's apex shape the layout near it: a
+        // disk needs one anchor, to pair and orient its loop.
+        let need = match (ss.genus, ss.boundary_loops) {
+            (0, 0) => 3,
+            (0, _) => 1,
+            _ => 6,
+        };
         anchor_pairs(&self.anchors, method, need, ss, ts)
     }
 
@@ -237,6 +253,7 @@ mod tests {
     fn a_negative_smoothing_step_is_out_of_range() {
         let m = shapes::icosphere(1);
         let mut spec = LayoutSpec {
+            boundaries: Vec::new(),
             anchors: crate::pipeline::AnchorRow::ids(vec![[0, 0], [3, 3], [7, 7]]),
             options: Default::default(),
         };
@@ -251,6 +268,7 @@ mod tests {
     fn the_wrong_number_of_meshes_is_a_spec_error() {
         let m = topology::summary(&shapes::icosphere(1));
         let spec = JobSpec::Greedy(LayoutSpec {
+            boundaries: Vec::new(),
             anchors: crate::pipeline::AnchorRow::ids(vec![[0, 0], [3, 3], [7, 7]]),
             options: Default::default(),
         });

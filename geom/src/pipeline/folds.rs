@@ -151,6 +151,7 @@ mod tests {
         let t = stretched(&s);
         let anchors: Vec<[u64; 2]> = [0u64, 5, 9, 13, 21, 40].iter().map(|&i| [i, i]).collect();
         let spec = JobSpec::Voronoi(LayoutSpec {
+            boundaries: Vec::new(),
             anchors: crate::pipeline::AnchorRow::ids(anchors),
             options: MapOptions { metric_samples: 1000, ..Default::default() },
         });

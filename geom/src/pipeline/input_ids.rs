@@ -49,7 +49,14 @@ pub fn to_welded<'a>(spec: &'a JobSpec, layouts: &[Option<&InputLayout>]) -> Res
     let table = |k: usize| tables.get(k).copied().flatten();
     let mut s = spec.clone();
     match &mut s {
-        JobSpec::Voronoi(l) | JobSpec::Greedy(l) => id_rows(&mut l.anchors, &table)?,
+        JobSpec::Voronoi(l) | JobSpec::Greedy(l) => {
+            id_rows(&mut l.anchors, &table)?;
+            for row in &mut l.boundaries {
+                for (k, id) in row.iter_mut().enumerate() {
+                    map_id(id, table(k), k)?;
+                }
+            }
+        }
         JobSpec::Homology(h) => {
             id_rows(&mut h.anchors, &table)?;
             for f in &mut h.features {

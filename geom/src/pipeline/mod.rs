@@ -18,6 +18,8 @@ mod input_ids;
 mod layout_outputs;
 mod limits;
 mod memory;
+pub mod open_loops;
+mod open_map;
 mod optimize;
 pub mod parts;
 pub mod quad;
@@ -214,6 +216,7 @@ mod cancel_tests {
         let t = t.unwrap();
         let anchors: Vec<[u64; 2]> = [0u64, 5, 9, 13, 21, 40].iter().map(|&i| [i, i]).collect();
         let spec = JobSpec::Voronoi(LayoutSpec {
+            boundaries: Vec::new(),
             anchors: crate::pipeline::AnchorRow::ids(anchors),
             options: MapOptions::default(),
         });

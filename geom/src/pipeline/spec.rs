@@ -52,6 +52,11 @@ impl Method {
 #[serde(deny_unknown_fields)]
 pub struct LayoutSpec {
     pub anchors: Vec<AnchorRow>,
+    /// Open meshes: one row `[source vertex, target vertex]` per boundary loop that no anchor
+    /// lies on, naming a vertex of each loop that correspond (optional; a loop with neither
+    /// pairs through the anchor nearest to it).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub boundaries: Vec<[u64; 2]>,
     #[serde(default)]
     pub options: MapOptions,
 }
@@ -234,8 +239,12 @@ impl JobSpec {
         let a: A = serde_json::from_slice(bytes).map_err(|e| InputError::Spec(format!("anchors file: {e}")))?;
         let (A::Obj { anchors } | A::List(anchors)) = a;
         match method {
-            Method::Voronoi => Ok(JobSpec::Voronoi(LayoutSpec { anchors, options: MapOptions::default() })),
-            Method::Greedy => Ok(JobSpec::Greedy(LayoutSpec { anchors, options: MapOptions::default() })),
+            Method::Voronoi => {
+                Ok(JobSpec::Voronoi(LayoutSpec { boundaries: Vec::new(), anchors, options: MapOptions::default() }))
+            }
+            Method::Greedy => {
+                Ok(JobSpec::Greedy(LayoutSpec { boundaries: Vec::new(), anchors, options: MapOptions::default() }))
+            }
             Method::Homology => Ok(JobSpec::Homology(HomologySpec {
                 anchors,
                 features: Vec::new(),

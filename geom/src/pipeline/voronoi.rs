@@ -5,6 +5,7 @@
 use super::common::relax::{Direction, finish_direction, measure_direction, relax_direction};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
 use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
+use super::open_loops::{BoundaryReport, OpenPlan};
 use super::optimize::{self, OptimizeReport, Quality};
 use super::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
 use crate::crossparam::global::GlobalParamOptions;
@@ -33,6 +34,9 @@ pub struct LayoutMapReport {
     /// The optimization in the base domain, when the composed maps were far from isometric.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimize: Option<Box<OptimizeReport>>,
+    /// Open meshes: how each pair of boundary loops was mapped.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub boundaries: Vec<BoundaryReport>,
 }
 
 /// A layout conflict's message, naming the source anchors whose Voronoi cells are not disks
@@ -65,6 +69,7 @@ fn build_layout<'m>(
     (source, target): (&'m Mesh, &'m Mesh),
     (sa, ta): (&[VertexId], &[VertexId]),
     o: &MapOptions,
+    plan: Option<&OpenPlan>,
     clock: &Clock,
     progress: &mut dyn Progress,
 ) -> Result<Layout<'m>> {
@@ -77,6 +82,9 @@ fn build_layout<'m>(
     loop {
         let (st, tt) = both(|| Tracer::new(target, ta, &edge_nodes), || Tracer::new(source, sa, &edge_nodes))?;
         let (mut st, mut tt) = (st?, tt?);
+        if let Some(p) = plan {
+            p.fix(&mut st, &mut tt)?;
+        }
         let built = match used {
             Method::Voronoi => voronoi::source_layout(&mut st, chi, &o.layout, progress).and_then(|(cl, mut s)| {
                 let t = voronoi::target_layout_with_restarts(&st, &cl, &mut tt, &o.layout, 8, progress)?;
@@ -121,19 +129,19 @@ fn build_layout<'m>(
 }
 
 /// The source and target of a job with their anchors, both ways.
-struct Pair<'a> {
-    source: &'a Mesh,
-    target: &'a Mesh,
-    pairs: &'a [(VertexId, VertexId)],
-    rev: &'a [(VertexId, VertexId)],
-    sa: &'a [VertexId],
-    ta: &'a [VertexId],
+pub(super) struct Pair<'a> {
+    pub source: &'a Mesh,
+    pub target: &'a Mesh,
+    pub pairs: &'a [(VertexId, VertexId)],
+    pub rev: &'a [(VertexId, VertexId)],
+    pub sa: &'a [VertexId],
+    pub ta: &'a [VertexId],
 }
 
 impl Pair<'_> {
     /// Relaxes and measures the maps both ways, one direction on a side thread, so the
     /// lighter direction's metrics overlap the heavier direction's smoothing.
-    fn finish(
+    pub(super) fn finish(
         &self,
         (s2t, t2s): (SurfaceMap, SurfaceMap),
         o: &RelaxOptions,
@@ -202,6 +210,71 @@ impl Pair<'_> {
 /// Both directions relaxed: each map and what relaxing it did.
 type Relaxed = ((SurfaceMap, SmoothReport), (SurfaceMap, SmoothReport));
 
+/// A layout's maps composed through its patches: both tracers, the patches, the refined meshes,
+/// the patch parameterizations and the maps both ways.
+pub(super) struct Composed<'m> {
+    pub st: Tracer<'m>,
+    pub tt: Tracer<'m>,
+    pub stats: LayoutStats,
+    pub patches: Vec<crate::domain::Patch>,
+    pub rs: crate::domain::refine::Refined,
+    pub rt: crate::domain::refine::Refined,
+    pub ps: Vec<crate::crossparam::PatchParam>,
+    pub pt: Vec<crate::crossparam::PatchParam>,
+    pub s2t: SurfaceMap,
+    pub t2s: SurfaceMap,
+}
+
+/// Layout, path flips and straightening, refinement, patch parameterization and composition:
+/// the steps every `voronoi` and `greedy` job shares (`plan`: the fixed paths of open meshes'
+/// loops, on their closed meshes).
+pub(super) fn compose_layout<'m>(
+    method: Method,
+    (source, target): (&'m Mesh, &'m Mesh),
+    (sa, ta): (&[VertexId], &[VertexId]),
+    o: &MapOptions,
+    plan: Option<&OpenPlan>,
+    clock: &mut Clock,
+    progress: &mut dyn Progress,
+) -> Result<Composed<'m>> {
+    progress.report(Stage::Layout, 0.0);
+    let Layout { source: mut st, target: mut tt, mut stats } =
+        build_layout(method, (source, target), (sa, ta), o, plan, clock, progress)?;
+    clock.lap("layout");
+    stats.flipped = crate::domain::flip::flip_paths(&mut st, &mut tt, &o.layout.flip, progress)?.flipped;
+    clock.lap("flip");
+    let rounds = o.layout.straighten_rounds;
+    let mut side = progress.silent();
+    let (a, b) = both(
+        || crate::domain::straighten::straighten(&mut tt, rounds, &mut side),
+        || crate::domain::straighten::straighten(&mut st, rounds, progress),
+    )?;
+    stats.straightened = a? + b?;
+    clock.lap("straighten");
+    let patches = patches_of(&st);
+    stats.patches = patches.len();
+    progress.check()?;
+    // The target tracer moves to the side thread (its scratch is not `Sync`).
+    let (tt_ref, pr) = (&mut tt, &patches);
+    let (rs, rt) = both(move || refine(tt_ref, pr), || refine(&st, &patches))?;
+    let (rs, rt) = (rs?, rt?);
+    clock.lap("refine");
+    let mut side = progress.silent();
+    let (ps, pt) = both(
+        || parameterize_patches(&rt, &patches, ta, &o.param, &mut side),
+        || parameterize_patches(&rs, &patches, sa, &o.param, progress),
+    )?;
+    let (ps, pt) = (ps?, pt?);
+    clock.lap("parameterize");
+    let pairs: Vec<(VertexId, VertexId)> = sa.iter().copied().zip(ta.iter().copied()).collect();
+    let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
+    progress.report(Stage::Compose, 0.0);
+    let (s2t, t2s) =
+        both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
+    clock.lap("compose");
+    Ok(Composed { st, tt, stats, patches, rs, rt, ps, pt, s2t, t2s })
+}
+
 /// Runs a `voronoi` or `greedy` job.
 ///
 /// # Errors
@@ -232,43 +305,22 @@ fn run_with(
     let mut clock = Clock::start();
     let pairs = spec.validate(method, source, target)?;
     let o = &spec.options;
+    let open = (!topology::boundary_loops(source).is_empty() || !topology::boundary_loops(target).is_empty())
+        .then(|| {
+            let rows: Vec<(VertexId, VertexId)> =
+                spec.boundaries.iter().map(|&[s, t]| (VertexId(s as u32), VertexId(t as u32))).collect();
+            OpenPlan::new(source, target, &pairs, &rows)
+        })
+        .transpose()?;
+    if let Some(plan) = open {
+        return super::open_map::run(method, o, plan, (source, target), &pairs, clock, progress);
+    }
     let sa: Vec<VertexId> = pairs.iter().map(|p| p.0).collect();
     let ta: Vec<VertexId> = pairs.iter().map(|p| p.1).collect();
     clock.lap("setup");
-    progress.report(Stage::Layout, 0.0);
-    let Layout { source: mut st, target: mut tt, mut stats } =
-        build_layout(method, (source, target), (&sa, &ta), o, &clock, progress)?;
-    clock.lap("layout");
-    stats.flipped = crate::domain::flip::flip_paths(&mut st, &mut tt, &o.layout.flip, progress)?.flipped;
-    clock.lap("flip");
-    let rounds = o.layout.straighten_rounds;
-    let mut side = progress.silent();
-    let (a, b) = both(
-        || crate::domain::straighten::straighten(&mut tt, rounds, &mut side),
-        || crate::domain::straighten::straighten(&mut st, rounds, progress),
-    )?;
-    stats.straightened = a? + b?;
-    clock.lap("straighten");
-    let patches = patches_of(&st);
-    stats.patches = patches.len();
-    progress.check()?;
-    // The target tracer moves to the side thread (its scratch is not `Sync`).
-    let (tt_ref, pr) = (&mut tt, &patches);
-    let (rs, rt) = both(move || refine(tt_ref, pr), || refine(&st, &patches))?;
-    let (rs, rt) = (rs?, rt?);
-    clock.lap("refine");
-    let mut side = progress.silent();
-    let (ps, pt) = both(
-        || parameterize_patches(&rt, &patches, &ta, &o.param, &mut side),
-        || parameterize_patches(&rs, &patches, &sa, &o.param, progress),
-    )?;
-    let (ps, pt) = (ps?, pt?);
-    clock.lap("parameterize");
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
-    progress.report(Stage::Compose, 0.0);
-    let (s2t, t2s) =
-        both(|| compose(&pt, target, &rs, &ps, source, &rev), || compose(&ps, source, &rt, &pt, target, &pairs))?;
-    clock.lap("compose");
+    let c = compose_layout(method, (source, target), (&sa, &ta), o, None, &mut clock, progress)?;
+    let Composed { st, tt, stats, patches, rs, rt, ps, pt, s2t, t2s } = c;
     let inputs = GlobalInputs { patches: &patches, refined: (&rs, &rt), anchors: (&sa, &ta), params: (&ps, &pt) };
     let (maps, contender, mut global) = choose_global(source, target, &inputs, (s2t, t2s), &pairs, &rev, go, progress)?;
     clock.lap("global");
@@ -309,7 +361,14 @@ fn run_with(
     progress.check()?;
     let metrics = (m1, m2);
     let pair = PairReport::new(method.name(), pairs.len(), (source, target), metrics, r1.merge(r2));
-    let mut report = LayoutMapReport { pair, patches: patches.len(), layout: stats, global, optimize: optimized };
+    let mut report = LayoutMapReport {
+        pair,
+        patches: patches.len(),
+        layout: stats,
+        global,
+        optimize: optimized,
+        boundaries: Vec::new(),
+    };
     let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, (&s2t, &t2s), &on_target, &on_source)?;
     clock.lap("artifacts");
     report.pair = report.pair.with_maps(s2t, t2s);
@@ -335,7 +394,7 @@ mod tests {
         options.layout.max_attempts = 1;
         options.layout.rebuilds = 0;
         options.layout.greedy_fallback = false;
-        let spec = LayoutSpec { anchors: crate::pipeline::AnchorRow::ids(anchors), options };
+        let spec = LayoutSpec { boundaries: Vec::new(), anchors: crate::pipeline::AnchorRow::ids(anchors), options };
         let Err(Error::Input(e @ InputError::LayoutConflict(_))) = run(Method::Voronoi, &spec, &m, &m, &mut NoProgress)
         else {
             panic!("expected a layout conflict");
@@ -353,7 +412,11 @@ mod tests {
         let m = shapes::icosphere(3);
         let mut options = MapOptions { metric_samples: 1000, ..Default::default() };
         options.smoothing.iterations = 0;
-        let spec = LayoutSpec { anchors: crate::pipeline::AnchorRow::ids((0..12).map(|i| [i, i])), options };
+        let spec = LayoutSpec {
+            boundaries: Vec::new(),
+            anchors: crate::pipeline::AnchorRow::ids((0..12).map(|i| [i, i])),
+            options,
+        };
         let go = GlobalParamOptions { force: true, ..Default::default() };
         let (r, arts) = run_with(Method::Voronoi, &spec, &go, optimize::GATE, &m, &m, &mut NoProgress).unwrap();
         let g = r.global.unwrap();
@@ -385,7 +448,7 @@ mod tests {
         let mut options = MapOptions { metric_samples: 2000, ..Default::default() };
         options.smoothing.iterations = 0;
         options.global.enabled = false;
-        let spec = LayoutSpec { anchors: crate::pipeline::AnchorRow::ids(anchors), options };
+        let spec = LayoutSpec { boundaries: Vec::new(), anchors: crate::pipeline::AnchorRow::ids(anchors), options };
         let go = GlobalParamOptions { enabled: false, ..Default::default() };
         let (plain, _) = run_with(Method::Voronoi, &spec, &go, f64::INFINITY, &s, &t, &mut NoProgress).unwrap();
         let (opt, _) = run_with(Method::Voronoi, &spec, &go, 0.0, &s, &t, &mut NoProgress).unwrap();

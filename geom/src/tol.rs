@@ -13,3 +13,6 @@ pub const SOLVE_RESIDUAL_REL: f64 = 1e-8;
 pub const BARY_EPS: f64 = 1e-12;
 /// A planar triangle with signed area at or below this times the mean |area| is flipped or degenerate.
 pub const PLANAR_DEGENERATE_REL: f64 = 1e-14;
+/// A planar triangle with |signed area| (twice the area) at or below this times its longest edge
+/// squared is degenerate: its three corners are collinear up to rounding.
+pub const PLANAR_COLLINEAR_REL: f64 = 1e-12;

@@ -19,7 +19,7 @@ pub mod untangle;
 pub mod visible;
 
 pub use compose::compose;
-pub use patch_param::{PatchParam, PatchParamOptions, parameterize_patches};
+pub use patch_param::{PatchParam, PatchParamOptions, SideFractions, parameterize_patches, parameterize_patches_with};
 
 /// The canonical triangle's corners, counter-clockwise.
 pub const TRIANGLE: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.5, 0.866_025_403_784_438_6]];

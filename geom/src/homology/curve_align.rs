@@ -61,7 +61,7 @@ pub fn arc_fractions(cut: &FeatureCutResult) -> SideFractions {
 }
 
 /// Sum of the corner angles at every vertex of `mesh` (a boundary vertex's interior angle).
-fn angle_sums(mesh: &crate::mesh::Mesh) -> Vec<f64> {
+pub(crate) fn angle_sums(mesh: &crate::mesh::Mesh) -> Vec<f64> {
     let mut out = vec![0.0; mesh.n_vertices()];
     for f in mesh.faces() {
         let p = f.map(|v| mesh.position(v));
@@ -130,7 +130,7 @@ fn agree_on_both_sides(cut: &FeatureCutResult, ft: &mut SideFractions) {
 
 /// Target fractions (without the closing 1) warped onto the source's, or `None` when the
 /// sides are too long to align or too short to need it.
-fn warp(a: &[f64], da: &[f64], b: &[f64], db: &[f64], o: &CurveAlignOptions) -> Option<Vec<f64>> {
+pub(crate) fn warp(a: &[f64], da: &[f64], b: &[f64], db: &[f64], o: &CurveAlignOptions) -> Option<Vec<f64>> {
     let (n, m) = (a.len(), b.len());
     if n < 3 || m < 3 || n.checked_mul(m)? > o.max_cells {
         return None;

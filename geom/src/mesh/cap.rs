@@ -138,11 +138,11 @@ impl Capped {
     ) -> Result<SurfaceMap> {
         let mut face = Vec::with_capacity(from_vertices);
         let mut bary = Vec::with_capacity(from_vertices);
-        for v in 0..from_vertices {
+        for (v, &looped) in on_loop.iter().enumerate().take(from_vertices) {
             let (f, mut b) = self.restrict(map.face[v], map.bary[v], tol).ok_or_else(|| {
                 Error::Numerical(format!("vertex {v} of the open mesh maps inside the cap of a boundary loop"))
             })?;
-            if on_loop[v] {
+            if looped {
                 snap_to_boundary(&self.mesh, f, &mut b, tol, self.open_faces);
             }
             face.push(f);

@@ -7,9 +7,12 @@
 //! ([`crate::domain::loops`]), so every patch map takes loop onto loop and cone onto cone, and
 //! the maps restrict to the open meshes ([`Capped::restrict_map`]).
 
+use crate::crossparam::SideFractions;
 use crate::domain::loops::{LoopAnchors, loop_paths};
+use crate::domain::refine::Refined;
 use crate::domain::tracer::Tracer;
 use crate::error::{InputError, Result};
+use crate::homology::curve_align::{CurveAlignOptions, angle_sums, warp};
 use crate::map::SurfaceMap;
 use crate::mesh::cap::{CapLoop, Capped, cap_loops};
 use crate::mesh::{Mesh, VertexId};
@@ -52,6 +55,8 @@ pub struct OpenPlan {
     pub held: usize,
     s_loops: Vec<LoopAnchors>,
     t_loops: Vec<LoopAnchors>,
+    /// Interior angle at each vertex of the open meshes (the loops' turning, for alignment).
+    angles: [Vec<f64>; 2],
     report: Vec<BoundaryReport>,
 }
 
@@ -61,6 +66,29 @@ fn name(l: &CapLoop) -> LoopName {
 
 fn names(c: &Capped) -> Vec<LoopName> {
     c.loops.iter().map(name).collect()
+}
+
+/// Equal boundary-loop counts, or `InputError::TopologyMismatch` naming each mesh's loops
+/// (first vertex and length).
+///
+/// # Errors
+/// As above.
+pub fn check_loop_counts(source: &Mesh, target: &Mesh) -> Result<()> {
+    let (ls, lt) = (crate::topology::boundary_loops(source), crate::topology::boundary_loops(target));
+    if ls.len() == lt.len() {
+        return Ok(());
+    }
+    let names = |m: &Mesh, l: &[Vec<crate::mesh::HalfedgeId>]| -> Vec<LoopName> {
+        l.iter().map(|hs| LoopName { first_vertex: m.tail(hs[0]).0, vertices: hs.len() }).collect()
+    };
+    Err(InputError::TopologyMismatch(format!(
+        "the source has {} boundary loops {:?}, the target {} {:?}: loops map one to one",
+        ls.len(),
+        names(source, &ls),
+        lt.len(),
+        names(target, &lt)
+    ))
+    .into())
 }
 
 /// Per vertex of the open mesh: the loop it lies on.
@@ -276,7 +304,8 @@ impl OpenPlan {
             s_loops.push(LoopAnchors { apex, anchors: ids.clone(), vertices: cs.loops[i].vertices.clone() });
             t_loops.push(LoopAnchors { apex, anchors: ids, vertices: ct.loops[j].vertices.clone() });
         }
-        Ok(OpenPlan { source: cs, target: ct, sa, ta, held, s_loops, t_loops, report })
+        let angles = [angle_sums(source), angle_sums(target)];
+        Ok(OpenPlan { source: cs, target: ct, sa, ta, held, s_loops, t_loops, angles, report })
     }
 
     /// Gives both tracers (on the closed meshes) the loops' fixed paths and closes the cones.
@@ -289,6 +318,41 @@ impl OpenPlan {
         let pt = loop_paths(tt.graph(), tt.anchors(), &self.t_loops)?;
         tt.fix(pt, &self.target.cap_faces())?;
         Ok(())
+    }
+
+    /// Where the target's loop vertices sit along their layout paths: each loop segment's
+    /// vertices aligned with the source's by dynamic time warping of arc length and turning
+    /// ([`crate::homology::curve_align`]), so that a zigzag boundary's tips land on tips and no
+    /// triangle with three corners on the loop folds; refined vertices between them by arc
+    /// length. `rt` is the target's refinement along its layout, whose paths start with the
+    /// loops' fixed ones (each loop's segments, then its spokes).
+    pub fn target_sides(&self, rt: &Refined) -> SideFractions {
+        let mut out: SideFractions = vec![None; rt.mesh.n_vertices()];
+        let mut path = 0;
+        for (sl, tl) in self.s_loops.iter().zip(&self.t_loops) {
+            let k = sl.anchors.len();
+            for i in 0..k {
+                let s = segment(&self.source.mesh, sl, &self.sa, i, &self.angles[0]);
+                let t = segment(&self.target.mesh, tl, &self.ta, i, &self.angles[1]);
+                let mut w = warp(&s.0, &s.1, &t.0, &t.1, &CurveAlignOptions::default())
+                    .unwrap_or_else(|| t.0[..t.0.len() - 1].to_vec());
+                w.push(1.0);
+                // Knots: the target's arc length at each loop vertex, and its aligned fraction.
+                let total = t.2;
+                let pv = &rt.path_vertices[path + i];
+                let mut at = 0.0;
+                for j in 1..pv.len().saturating_sub(1) {
+                    at += (rt.mesh.position(pv[j]) - rt.mesh.position(pv[j - 1])).norm();
+                    let x = at / total.max(f64::MIN_POSITIVE);
+                    let q = t.0.partition_point(|&f| f <= x).clamp(1, t.0.len() - 1);
+                    let (f0, f1) = (t.0[q - 1], t.0[q]);
+                    let u = if f1 > f0 { ((x - f0) / (f1 - f0)).clamp(0.0, 1.0) } else { 0.0 };
+                    out[pv[j].idx()] = Some((sl.anchors[i], w[q - 1] + u * (w[q] - w[q - 1])));
+                }
+            }
+            path += 2 * k;
+        }
+        out
     }
 
     /// The maps of the closed meshes restricted to the open ones (source → target, target →
@@ -319,6 +383,27 @@ impl OpenPlan {
         }
         out
     }
+}
+
+/// Loop segment `i` (from its `i`-th anchor to the next) of one mesh: the arc-length fraction
+/// of each of its vertices (1 at the end), their interior angles, and its length.
+fn segment(m: &Mesh, l: &LoopAnchors, anchors: &[VertexId], i: usize, angles: &[f64]) -> (Vec<f64>, Vec<f64>, f64) {
+    let n = l.vertices.len();
+    let k = l.anchors.len();
+    let pos = |a: u32| l.vertices.iter().position(|&v| v == anchors[a as usize]).unwrap_or(0);
+    let (from, to) = (pos(l.anchors[i]), pos(l.anchors[(i + 1) % k]));
+    let steps = match (to + n - from) % n {
+        0 => n,
+        s => s,
+    };
+    let vs: Vec<VertexId> = (0..=steps).map(|s| l.vertices[(from + s) % n]).collect();
+    let mut cum = vec![0.0];
+    for w in vs.windows(2) {
+        cum.push(cum[cum.len() - 1] + (m.position(w[1]) - m.position(w[0])).norm());
+    }
+    let total = cum[cum.len() - 1];
+    let frac = cum.iter().map(|c| c / total.max(f64::MIN_POSITIVE)).collect();
+    (frac, vs.iter().map(|v| angles[v.idx()]).collect(), total)
 }
 
 /// Per vertex of the open mesh: is it on a loop?

@@ -36,7 +36,7 @@ pub(super) fn run(
     progress.check()?;
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
     // The loop anchors are held like the job's own; the apexes are not on the open meshes.
-    let held = plan.held;
+    let held = pairs.len();
     let pair = Pair { source, target, pairs, rev: &rev, sa: &sa[..held], ta: &ta[..held] };
     let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = pair.finish(maps, &o.relax(), &mut clock, progress)?;
     // Relaxation keeps boundary images where the patch maps put them; counted anyway.

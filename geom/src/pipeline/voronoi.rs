@@ -10,7 +10,7 @@ use super::optimize::{self, OptimizeReport, Quality};
 use super::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
 use crate::crossparam::global::GlobalParamOptions;
 use crate::crossparam::smooth::SmoothReport;
-use crate::crossparam::{compose, parameterize_patches};
+use crate::crossparam::{compose, parameterize_patches, parameterize_patches_with};
 use crate::domain::refine::refine;
 use crate::domain::tracer::Tracer;
 use crate::domain::{LayoutStats, greedy, patches_of, voronoi};
@@ -260,8 +260,9 @@ pub(super) fn compose_layout<'m>(
     let (rs, rt) = (rs?, rt?);
     clock.lap("refine");
     let mut side = progress.silent();
+    let sides = plan.map(|p| p.target_sides(&rt));
     let (ps, pt) = both(
-        || parameterize_patches(&rt, &patches, ta, &o.param, &mut side),
+        || parameterize_patches_with(&rt, &patches, ta, &o.param, sides.as_ref(), &mut side),
         || parameterize_patches(&rs, &patches, sa, &o.param, progress),
     )?;
     let (ps, pt) = (ps?, pt?);
@@ -303,6 +304,7 @@ fn run_with(
     progress: &mut dyn Progress,
 ) -> Result<(LayoutMapReport, Vec<Artifact>)> {
     let mut clock = Clock::start();
+    super::open_loops::check_loop_counts(source, target)?;
     let pairs = spec.validate(method, source, target)?;
     let o = &spec.options;
     let open = (!topology::boundary_loops(source).is_empty() || !topology::boundary_loops(target).is_empty())

@@ -62,7 +62,29 @@ fn f32p(p: &P3) -> [f32; 3] {
 /// A `.glb` of `m`: attributes as given; morph targets with weight 0, named in
 /// `mesh.extras.targetNames`.
 pub fn write_glb_mesh(m: &GlbMesh) -> Vec<u8> {
+    write_glb_meshes(&[("surfmap", m)])
+}
+
+/// A `.glb` with one named node and mesh per entry, in one scene (as [`write_glb_mesh`]).
+pub fn write_glb_meshes(meshes: &[(&str, &GlbMesh)]) -> Vec<u8> {
     let mut b = Builder::default();
+    let gltf_meshes: Vec<Value> = meshes.iter().map(|(name, m)| mesh_json(&mut b, name, m)).collect();
+    let nodes: Vec<Value> = meshes.iter().enumerate().map(|(i, (name, _))| json!({"mesh": i, "name": name})).collect();
+    let doc = json!({
+        "asset": {"version": "2.0", "generator": "surfmap"},
+        "scene": 0,
+        "scenes": [{"nodes": (0..meshes.len()).collect::<Vec<_>>()}],
+        "nodes": nodes,
+        "meshes": gltf_meshes,
+        "buffers": [{"byteLength": b.bin.len()}],
+        "bufferViews": b.views,
+        "accessors": b.accessors,
+    });
+    container(serde_json::to_vec(&doc).unwrap_or_default(), b.bin)
+}
+
+/// One mesh's accessors into `b`, and its glTF `mesh` object.
+fn mesh_json(b: &mut Builder, name: &str, m: &GlbMesh) -> Value {
     let base: Vec<[f32; 3]> = m.positions.iter().map(f32p).collect();
     let mut attrs = serde_json::Map::new();
     attrs.insert("POSITION".into(), json!(b.floats(&base, true)));
@@ -100,7 +122,7 @@ pub fn write_glb_mesh(m: &GlbMesh) -> Vec<u8> {
     }
     let names: Vec<&str> = m.targets.iter().map(|(n, _)| n.as_str()).collect();
     let mut mesh = json!({
-        "name": "surfmap",
+        "name": name,
         "primitives": [{"attributes": attrs, "indices": indices, "mode": 4}],
     });
     if !m.targets.is_empty() {
@@ -108,17 +130,7 @@ pub fn write_glb_mesh(m: &GlbMesh) -> Vec<u8> {
         mesh["weights"] = json!(vec![0.0; m.targets.len()]);
         mesh["extras"] = json!({"targetNames": names});
     }
-    let doc = json!({
-        "asset": {"version": "2.0", "generator": "surfmap"},
-        "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [mesh],
-        "buffers": [{"byteLength": b.bin.len()}],
-        "bufferViews": b.views,
-        "accessors": b.accessors,
-    });
-    container(serde_json::to_vec(&doc).unwrap_or_default(), b.bin)
+    mesh
 }
 
 /// A `.glb` with `base` and `faces`, and one morph target per `(name, positions)` (same vertex
@@ -153,21 +165,51 @@ fn container(mut js: Vec<u8>, mut bin: Vec<u8>) -> Vec<u8> {
 /// given per welded vertex (each copy of a vertex moves with it). Without a layout, the mesh's
 /// own vertices, with its UVs and normals when it has them.
 pub fn write_layout_glb(mesh: &crate::Mesh, layout: Option<&InputLayout>, targets: &[(String, Vec<P3>)]) -> Vec<u8> {
-    match layout {
-        Some(l) => {
-            let positions = l.spread(mesh.positions());
-            let targets: Vec<(String, Vec<P3>)> = targets.iter().map(|(n, t)| (n.clone(), l.spread(t))).collect();
-            write_glb_mesh(&GlbMesh {
-                positions: &positions,
-                triangles: &l.triangles,
-                attributes: &l.attributes,
-                targets: &targets,
-            })
-        }
-        None => {
-            let attributes = Attributes::from(mesh.attributes());
-            let tris: Vec<[u32; 3]> = mesh.faces().iter().map(|f| f.map(|v| v.0)).collect();
-            write_glb_mesh(&GlbMesh { positions: mesh.positions(), triangles: &tris, attributes: &attributes, targets })
-        }
+    write_layout_glbs(&[LayoutGlb { name: "surfmap", mesh, layout, targets }])
+}
+
+/// One mesh of [`write_layout_glbs`].
+pub struct LayoutGlb<'a> {
+    pub name: &'a str,
+    pub mesh: &'a crate::Mesh,
+    pub layout: Option<&'a InputLayout>,
+    pub targets: &'a [(String, Vec<P3>)],
+}
+
+/// A `.glb` with one node per mesh, each as [`write_layout_glb`] writes it.
+pub fn write_layout_glbs(meshes: &[LayoutGlb]) -> Vec<u8> {
+    struct Owned {
+        positions: Vec<P3>,
+        triangles: Vec<[u32; 3]>,
+        attributes: Attributes,
+        targets: Vec<(String, Vec<P3>)>,
     }
+    let owned: Vec<Owned> = meshes
+        .iter()
+        .map(|m| match m.layout {
+            Some(l) => Owned {
+                positions: l.spread(m.mesh.positions()),
+                triangles: l.triangles.clone(),
+                attributes: l.attributes.clone(),
+                targets: m.targets.iter().map(|(n, t)| (n.clone(), l.spread(t))).collect(),
+            },
+            None => Owned {
+                positions: m.mesh.positions().to_vec(),
+                triangles: m.mesh.faces().iter().map(|f| f.map(|v| v.0)).collect(),
+                attributes: Attributes::from(m.mesh.attributes()),
+                targets: m.targets.to_vec(),
+            },
+        })
+        .collect();
+    let glb: Vec<GlbMesh> = owned
+        .iter()
+        .map(|o| GlbMesh {
+            positions: &o.positions,
+            triangles: &o.triangles,
+            attributes: &o.attributes,
+            targets: &o.targets,
+        })
+        .collect();
+    let named: Vec<(&str, &GlbMesh)> = meshes.iter().zip(&glb).map(|(m, g)| (m.name, g)).collect();
+    write_glb_meshes(&named)
 }

@@ -18,7 +18,9 @@ mod ply_binary;
 mod png16;
 mod stl;
 
-pub use glb_write::{GlbMesh, write_glb, write_glb_mesh, write_layout_glb};
+pub use glb_write::{
+    GlbMesh, LayoutGlb, write_glb, write_glb_mesh, write_glb_meshes, write_layout_glb, write_layout_glbs,
+};
 pub use obj::write_layout as write_obj_layout;
 pub use obj::write_uv_patches as write_obj_uv_patches;
 pub use ply::write_with_face_ints as write_ply_with_face_ints;

@@ -7,17 +7,19 @@ use super::common::Artifact;
 use crate::io;
 use crate::mesh::{InputLayout, Mesh, P3, VertexId};
 
-/// Adds `morph.glb` to a pair job's artifacts (not when a folded direction was withheld).
-/// `originals` are the inputs, `meshes` what the job ran on (with vertices inserted at point
-/// anchors, which come after the original ones and are left out).
+/// Adds `morph.glb` to a pair job's artifacts (not when a folded direction was withheld):
+/// the source in its own layout with one morph target on the target and, with `inverse`, the
+/// target in its own layout with one morph target on the source. `originals` are the inputs,
+/// `meshes` what the job ran on (with vertices inserted at point anchors, which come after the
+/// original ones and are left out).
 pub fn add_morph(
     report: &JobReport,
-    originals: &[Mesh],
-    meshes: &[Mesh],
+    (originals, meshes): (&[Mesh], &[Mesh]),
     layouts: &[Option<&InputLayout>],
+    inverse: bool,
     arts: &mut Vec<Artifact>,
 ) {
-    let (Some(pair), [source, _], [_, target]) = (report.pair(), originals, meshes) else {
+    let (Some(pair), [source, target0], [source1, target]) = (report.pair(), originals, meshes) else {
         return;
     };
     let Some(maps) = pair.maps.as_ref() else {
@@ -27,8 +29,22 @@ pub fn add_morph(
         return;
     }
     let on_target: Vec<P3> = (0..source.n_vertices()).map(|v| maps.s2t.position(VertexId(v as u32), target)).collect();
-    let layout = layouts.first().copied().flatten();
-    let bytes = io::write_layout_glb(source, layout, &[("target".into(), on_target)]);
+    let fwd = [("target".to_string(), on_target)];
+    let mut parts =
+        vec![io::LayoutGlb { name: "source", mesh: source, layout: layouts.first().copied().flatten(), targets: &fwd }];
+    let back;
+    if inverse {
+        let on_source: Vec<P3> =
+            (0..target0.n_vertices()).map(|v| maps.t2s.position(VertexId(v as u32), source1)).collect();
+        back = [("source".to_string(), on_source)];
+        parts.push(io::LayoutGlb {
+            name: "target",
+            mesh: target0,
+            layout: layouts.get(1).copied().flatten(),
+            targets: &back,
+        });
+    }
+    let bytes = io::write_layout_glbs(&parts);
     arts.push(Artifact { name: "morph.glb".into(), content_type: "model/gltf-binary", bytes });
 }
 

@@ -137,7 +137,12 @@ pub fn run_with_layouts(
         arts.push(common::json_artifact("metrics.json", &report)?);
     }
     folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
-    layout_outputs::add_morph(&report, originals, meshes, &layouts, &mut arts);
+    let inverse = match spec {
+        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => s.options.inverse_morph,
+        JobSpec::Homology(s) => s.options.inverse_morph,
+        JobSpec::Quad(_) => false,
+    };
+    layout_outputs::add_morph(&report, (originals, meshes), &layouts, inverse, &mut arts);
     layout_outputs::rewrite_objs(&report, originals, meshes, &layouts, &mut arts);
     if wants_transfer {
         transfer_output::add(&report, &transfer, (originals, meshes), &layouts, &mut arts)?;

@@ -100,6 +100,10 @@ pub struct MapOptions {
     /// `["TEXCOORD_0", "JOINTS_0", "WEIGHTS_0"]`.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub transfer: Vec<String>,
+    /// `morph.glb` also holds the target in its own layout with a morph target that places it
+    /// on the source (the inverse pair).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub inverse_morph: bool,
 }
 
 impl Default for MapOptions {
@@ -111,6 +115,7 @@ impl Default for MapOptions {
             smoothing: SmoothOptions::default(),
             metric_samples: 100_000,
             transfer: Vec::new(),
+            inverse_morph: false,
         }
     }
 }
@@ -156,6 +161,9 @@ pub struct HomologyOptions {
     /// As [`MapOptions::transfer`].
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub transfer: Vec<String>,
+    /// As [`MapOptions::inverse_morph`].
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub inverse_morph: bool,
 }
 
 impl Default for HomologyOptions {
@@ -170,6 +178,7 @@ impl Default for HomologyOptions {
             smoothing: SmoothOptions::default(),
             metric_samples: 100_000,
             transfer: Vec::new(),
+            inverse_morph: false,
         }
     }
 }

@@ -118,3 +118,36 @@ fn anchors_running_the_other_way_round_a_loop_are_refused() {
     assert_eq!(e.code(), "invalid_anchors", "{e}");
     assert!(e.to_string().contains("another order"), "{e}");
 }
+
+#[test]
+fn an_open_part_beside_a_closed_one_maps_with_its_boundaries_row() {
+    // A holed sphere plus a small closed sphere, in one mesh; the hole's loop is named by a
+    // `boundaries` row in whole-mesh ids, which the part's job gets in its own ids.
+    let disk = holed(&[0]);
+    let small = shapes::icosphere(1);
+    let n = disk.n_vertices() as u32;
+    let mut pos = disk.positions().to_vec();
+    pos.extend(small.positions().iter().map(|p| P3::new(4.0 + 0.3 * p.x, 0.3 * p.y, 0.3 * p.z)));
+    let mut tris = disk.face_indices();
+    tris.extend(small.face_indices().iter().map(|t| t.map(|v| v + n)));
+    let s = Mesh::from_triangles(pos, &tris).unwrap();
+    let t = stretched(&s);
+    let first = u64::from(disk.tail(geom::topology::boundary_loops(&disk)[0][0]).0);
+    let mut anchors: Vec<u64> = vec![20, 61, 100, 150, 222, 301];
+    anchors.extend([0u64, 3, 7, 9].iter().map(|k| u64::from(n) + k));
+    let JobSpec::Voronoi(mut l) = spec("voronoi", &anchors) else { unreachable!() };
+    l.boundaries = vec![[first, first]];
+    let (r, _) = run_job(&JobSpec::Voronoi(l), &[s, t], &mut NoProgress).unwrap();
+    let JobReport::Parts(p) = &r else { panic!("not a parts report") };
+    for m in [&p.pair.source_to_target, &p.pair.target_to_source] {
+        assert_eq!(m.flipped_faces, 0, "{m:?}");
+        assert!(m.anchor_error_max.unwrap() <= 1e-9, "{m:?}");
+    }
+    let open = p.parts.iter().find_map(|x| match x {
+        JobReport::Layout(l) if !l.boundaries.is_empty() => Some(l),
+        _ => None,
+    });
+    let b = &open.expect("the open part's report").boundaries[0];
+    assert_eq!(b.paired_by, "boundaries");
+    assert_eq!(b.off_loop, [0, 0]);
+}

@@ -99,7 +99,7 @@ impl HomologySpec {
         same_topology(ss, ts, self.features.is_empty())?;
         if ss.boundary_loops > 0 && ss.genus > 0 {
             return Err(InputError::TopologyMismatch(format!(
-                "boundary loops are supported on genus-0 surfaces (features on closed surfaces of any genus); these have genus {} and {} boundary loops",
+                "method homology maps boundary loops on genus-0 surfaces (features on closed surfaces of any genus); these have genus {} and {} boundary loops (methods voronoi and greedy map open surfaces of any genus)",
                 ss.genus, ss.boundary_loops
             ))
             .into());

@@ -133,7 +133,22 @@ pub fn run(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Resu
             .filter(|r| sl[r[0] as usize] as usize == a)
             .map(|r| [ls[r[0] as usize], lt[r[1] as usize]])
             .collect();
-        let sub = with_anchors(spec, AnchorRow::ids(local));
+        // `boundaries` rows (open parts) in the part's own numbering.
+        let mut bounds = Vec::new();
+        for (i, r) in boundary_rows(spec).iter().enumerate() {
+            let (Some(&ps_l), Some(&pt_l)) = (sl.get(r[0] as usize), lt.get(r[1] as usize)) else { continue };
+            if ps_l as usize != a {
+                continue;
+            }
+            if pt_l == u64::MAX {
+                return Err(InputError::Anchors(format!(
+                    "boundaries row {i} pairs a loop of source part {a} with a loop outside its partner part"
+                ))
+                .into());
+            }
+            bounds.push([ls[r[0] as usize], pt_l]);
+        }
+        let sub = with_anchors(spec, AnchorRow::ids(local), bounds);
         let (rep, part_arts) = run_job(&sub, &[ps.mesh.clone(), pt.mesh.clone()], progress)?;
         let maps =
             rep.pair().and_then(|p| p.maps.clone()).ok_or_else(|| crate::Error::Internal("a part's maps".into()))?;
@@ -177,11 +192,24 @@ fn anchor_rows(spec: &JobSpec) -> Option<&[AnchorRow]> {
     }
 }
 
-fn with_anchors(spec: &JobSpec, anchors: Vec<AnchorRow>) -> JobSpec {
+fn boundary_rows(spec: &JobSpec) -> &[[u64; 2]] {
+    match spec {
+        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => &s.boundaries,
+        _ => &[],
+    }
+}
+
+fn with_anchors(spec: &JobSpec, anchors: Vec<AnchorRow>, boundaries: Vec<[u64; 2]>) -> JobSpec {
     let mut s = spec.clone();
     match &mut s {
-        JobSpec::Voronoi(x) | JobSpec::Greedy(x) => (x.anchors, x.options.transfer) = (anchors, Vec::new()),
-        JobSpec::Homology(x) => (x.anchors, x.options.transfer) = (anchors, Vec::new()),
+        JobSpec::Voronoi(x) | JobSpec::Greedy(x) => {
+            (x.anchors, x.boundaries, x.options.transfer) = (anchors, boundaries, Vec::new());
+            x.options.inverse_morph = false;
+        }
+        JobSpec::Homology(x) => {
+            (x.anchors, x.options.transfer) = (anchors, Vec::new());
+            x.options.inverse_morph = false;
+        }
         JobSpec::Quad(_) => {}
     }
     s

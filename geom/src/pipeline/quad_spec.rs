@@ -93,7 +93,7 @@ impl QuadSpec {
         for (m, s) in summaries.iter().enumerate() {
             if s.components != 1 || s.boundary_loops != 0 {
                 return Err(InputError::TopologyMismatch(format!(
-                    "method quad partitions closed connected surfaces; mesh {m} has {} components and {} boundary loops",
+                    "method quad partitions closed connected surfaces; mesh {m} has {} components and {} boundary loops (methods voronoi and greedy map open meshes and meshes in several parts)",
                     s.components, s.boundary_loops
                 ))
                 .into());

@@ -45,6 +45,10 @@ impl Clusters {
     pub fn non_disk(&self, mesh: &Mesh) -> Vec<u32> {
         let mut out = Vec::new();
         for (a, faces) in self.faces.iter().enumerate() {
+            if faces.is_empty() {
+                // An anchor inside faces left out (a cone's apex) has no cell.
+                continue;
+            }
             let mut verts: Vec<VertexId> = faces.iter().flat_map(|&f| mesh.face(f)).collect();
             verts.sort_unstable();
             verts.dedup();
@@ -78,7 +82,16 @@ impl Clusters {
 /// # Errors
 /// As [`face_voronoi`].
 pub fn clusters(mesh: &Mesh, anchors: &[VertexId]) -> Result<Clusters> {
-    let fv = face_voronoi(mesh, anchors, &FaceVoronoiOptions::default())?;
+    clusters_in(mesh, anchors, None)
+}
+
+/// [`clusters`] of the faces in `faces` only (distances do not pass through the others: the
+/// cones that close an open mesh's loops, whose faces stay unlabelled).
+///
+/// # Errors
+/// As [`clusters`].
+pub fn clusters_in(mesh: &Mesh, anchors: &[VertexId], faces: Option<&[bool]>) -> Result<Clusters> {
+    let fv = face_voronoi(mesh, anchors, &FaceVoronoiOptions { faces })?;
     let label = fv.label;
     let mut by_pair: HashMap<(u32, u32), Vec<EdgeId>> = HashMap::new();
     for e in 0..mesh.n_edges() {

@@ -230,6 +230,11 @@ impl<'m> Tracer<'m> {
         Ok(t)
     }
 
+    /// The faces paths may cross (`None`: all of them).
+    pub fn open_faces(&self) -> Option<Vec<bool>> {
+        self.closed.iter().any(|&c| c).then(|| self.closed.iter().map(|&c| !c).collect())
+    }
+
     /// Number of fixed paths (they are paths `0..n`).
     pub fn n_fixed(&self) -> u32 {
         self.fixed

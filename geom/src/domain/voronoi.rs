@@ -15,7 +15,7 @@
 //! target's regions are the source's.
 
 use super::complete::complete;
-use super::cuts::{Clusters, clusters};
+use super::cuts::{Clusters, clusters_in};
 use super::tracer::{Half, TraceRequest, Tracer};
 use super::walks::walks;
 use super::{LayoutOptions, LayoutPath, LayoutStats, Sector};
@@ -70,7 +70,7 @@ pub fn source_layout(
 ) -> Result<(Clusters, LayoutStats)> {
     let mesh = t.mesh();
     let anchors = t.anchors().to_vec();
-    let cl = clusters(mesh, &anchors)?;
+    let cl = clusters_in(mesh, &anchors, t.open_faces().as_deref())?;
     let mut stats = LayoutStats { cuts: cl.cuts.len(), ..Default::default() };
     let mut order: Vec<usize> = (0..cl.cuts.len()).collect();
     let multi = |c: usize| cl.between(cl.cuts[c].i, cl.cuts[c].j).count() > 1;
@@ -202,7 +202,7 @@ pub fn target_layout(
     progress: &mut dyn Progress,
 ) -> Result<std::result::Result<LayoutStats, usize>> {
     let anchors = tgt.anchors().to_vec();
-    let cl = clusters(tgt.mesh(), &anchors)?;
+    let cl = clusters_in(tgt.mesh(), &anchors, tgt.open_faces().as_deref())?;
     let np = src.paths().len();
     let order = PathOrder::new(src, &cl, priority);
     // Fixed paths are on both meshes already, under the same numbers.

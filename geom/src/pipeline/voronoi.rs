@@ -41,8 +41,18 @@ pub struct LayoutMapReport {
 
 /// A layout conflict's message, naming the source anchors whose Voronoi cells are not disks
 /// (where a handle or tube is not separated by the anchors, the usual cause), if any.
-fn with_cell_hint(m: String, source: &Mesh, anchors: &[VertexId]) -> Error {
-    let bad = crate::domain::cuts::clusters(source, anchors).map(|c| c.non_disk(source)).unwrap_or_default();
+/// On an open mesh's closed copy (`plan`), cells are those of the open mesh and only the job's
+/// own anchors are named.
+fn with_cell_hint(m: String, source: &Mesh, anchors: &[VertexId], plan: Option<&OpenPlan>) -> Error {
+    let open = plan.map(|p| {
+        (0..source.n_faces()).map(|f| !p.source.is_cap_face(crate::mesh::FaceId::from_idx(f))).collect::<Vec<_>>()
+    });
+    let mut bad = crate::domain::cuts::clusters_in(source, anchors, open.as_deref())
+        .map(|c| c.non_disk(source))
+        .unwrap_or_default();
+    if let Some(p) = plan {
+        bad.retain(|&a| (a as usize) < p.job_anchors);
+    }
     let m = if bad.is_empty() {
         m
     } else {
@@ -122,7 +132,7 @@ fn build_layout<'m>(
                 }
                 attempt += 1;
             }
-            Err(Error::Input(InputError::LayoutConflict(m))) => return Err(with_cell_hint(m, source, sa)),
+            Err(Error::Input(InputError::LayoutConflict(m))) => return Err(with_cell_hint(m, source, sa, plan)),
             Err(e) => return Err(e),
         }
     }

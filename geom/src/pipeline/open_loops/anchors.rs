@@ -125,5 +125,6 @@ pub(super) fn with_loop_anchors(
         t_loops.push(LoopAnchors { apex, anchors: ids, vertices: ct.loops[j].vertices.clone() });
     }
     let angles = [angle_sums(source), angle_sums(target)];
-    Ok(OpenPlan { source: cs, target: ct, sa, ta, held, s_loops, t_loops, angles, report })
+    let job_anchors = pairs.len();
+    Ok(OpenPlan { source: cs, target: ct, sa, ta, held, job_anchors, s_loops, t_loops, angles, report })
 }

@@ -55,6 +55,8 @@ pub struct OpenPlan {
     pub ta: Vec<VertexId>,
     /// Anchors held through relaxation on the open meshes (all but the apexes).
     pub held: usize,
+    /// The job's own anchors (the first of `sa` / `ta`).
+    pub job_anchors: usize,
     s_loops: Vec<LoopAnchors>,
     t_loops: Vec<LoopAnchors>,
     /// Interior angle at each vertex of the open meshes (the loops' turning, for alignment).

@@ -454,3 +454,40 @@ async fn gltf_uploads_are_summarized_or_refused_by_extension() {
     assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("unsupported_extension")), "{e}");
     assert!(e["message"].as_str().unwrap().contains("KHR_draco_mesh_compression"), "{e}");
 }
+
+/// An open pair through the queue: a sphere with a hole onto a stretched copy, the loop named
+/// by a `boundaries` row; the job succeeds with the loop report, and a `boundaries` row past the
+/// meshes' vertices is refused at submission.
+#[tokio::test]
+async fn open_meshes_map_loop_onto_loop_through_the_queue() {
+    let t = setup().await;
+    let s = geom::mesh::shapes::icosphere(3);
+    let keep: Vec<[u32; 3]> =
+        s.faces().iter().filter(|f| !f.contains(&geom::VertexId(0))).map(|f| [f[0].0, f[1].0, f[2].0]).collect();
+    let open = geom::Mesh::from_triangles(s.positions().to_vec(), &keep).unwrap();
+    let stretched = open
+        .with_positions(open.positions().iter().map(|p| geom::mesh::P3::new(1.4 * p.x, p.y, 0.9 * p.z)).collect())
+        .unwrap();
+    let first = open.tail(geom::topology::boundary_loops(&open)[0][0]).0;
+    let (_, a) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&open, Format::Off))).await;
+    let (_, b) = json_call(&t, "POST", "/v1/meshes", Body::from(geom::io::write(&stretched, Format::Off))).await;
+    assert_eq!(a["summary"]["boundary_loops"], 1, "{a}");
+    let submit = |boundaries: Value| {
+        let spec = json!({"method": "voronoi", "anchors": [[20, 20], [61, 61], [100, 100], [222, 222]], "boundaries": boundaries});
+        let body = json!({"source": a["id"], "target": b["id"], "spec": spec}).to_string();
+        json_call(&t, "POST", "/v1/jobs", Body::from(body))
+    };
+    let (st, e) = submit(json!([[100000, 0]])).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("invalid_anchors")), "{e}");
+    let (st, job) = submit(json!([[first, first]])).await;
+    assert_eq!(st, StatusCode::ACCEPTED, "{job}");
+    let id = job["id"].as_str().unwrap().to_string();
+    let (_tx, rx) = tokio::sync::watch::channel(false);
+    assert_eq!(t.worker.run_once(&rx).await.unwrap(), Ran::Ran { job: id.clone(), outcome: "succeeded".into() });
+    let (_, done) = json_call(&t, "GET", &format!("/v1/jobs/{id}"), Body::empty()).await;
+    let r = &done["result"];
+    assert_eq!(r["source_to_target"]["flipped_faces"], 0, "{r}");
+    assert_eq!(r["target_to_source"]["flipped_faces"], 0, "{r}");
+    assert_eq!(r["boundaries"][0]["paired_by"], "boundaries", "{r}");
+    assert_eq!(r["boundaries"][0]["off_loop"], json!([0, 0]), "{r}");
+}

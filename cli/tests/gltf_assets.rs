@@ -9,13 +9,20 @@ use geom::io::{self, ReadOptions};
 use std::path::Path;
 use std::process::Command;
 
-/// Runs the Khronos validator (installed from `tests/gltf-validator/package.json` on first use)
-/// on a file; returns its summary.
+/// Runs the Khronos validator (installed from `tests/gltf-validator/package.json` on first use,
+/// once per test process: `npm ci` empties `node_modules` before it fills it, so a second test
+/// must not run the validator meanwhile) on a file; returns its summary.
 fn khronos_validate(file: &Path) -> serde_json::Value {
+    static INSTALL: std::sync::Mutex<bool> = std::sync::Mutex::new(false);
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/gltf-validator");
-    if !dir.join("node_modules/gltf-validator").exists() {
-        let o = Command::new("npm").args(["ci", "--no-audit", "--no-fund"]).current_dir(&dir).output().expect("npm");
-        assert!(o.status.success(), "npm ci: {}", String::from_utf8_lossy(&o.stderr));
+    {
+        let mut done = INSTALL.lock().unwrap_or_else(|e| e.into_inner());
+        if !*done && !dir.join("node_modules/gltf-validator/package.json").exists() {
+            let o =
+                Command::new("npm").args(["ci", "--no-audit", "--no-fund"]).current_dir(&dir).output().expect("npm");
+            assert!(o.status.success(), "npm ci: {}", String::from_utf8_lossy(&o.stderr));
+        }
+        *done = true;
     }
     let o = Command::new("node").arg(dir.join("validate.cjs")).arg(file).output().expect("node");
     assert!(o.status.success(), "validator: {}", String::from_utf8_lossy(&o.stderr));

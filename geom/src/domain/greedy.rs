@@ -18,12 +18,9 @@ fn pair_lengths(t: &Tracer) -> Result<Vec<Vec<f64>>> {
     let m = t.mesh();
     let scale = m.area().sqrt().max(f64::MIN_POSITIVE);
     let anchors = t.anchors();
-    // On an open mesh's closed copy, lengths over the open surface (not through a cone).
-    let open = t.open_faces();
-    let opts = VertexDijkstraOptions { faces: open.as_deref(), ..Default::default() };
     let mut out = Vec::with_capacity(anchors.len());
     for &a in anchors {
-        let d = vertex_dijkstra(m, &[(a, 0.0)], &opts)?;
+        let d = vertex_dijkstra(m, &[(a, 0.0)], &VertexDijkstraOptions::default())?;
         out.push(anchors.iter().map(|b| d.dist[b.idx()] / scale).collect());
     }
     Ok(out)

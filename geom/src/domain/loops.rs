@@ -83,3 +83,49 @@ pub fn loop_paths(g: &EdgeNodeGraph, anchors: &[VertexId], loops: &[LoopAnchors]
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domain::straighten::straighten;
+    use crate::domain::tracer::{TraceRequest, Tracer};
+    use crate::mesh::cap::cap_loops;
+    use crate::mesh::{Mesh, shapes};
+    use crate::progress::NoProgress;
+
+    /// A holed icosphere closed by a cone, its loop cut by three anchors: the fixed paths run
+    /// along the loop and the spokes, survive straightening and a fresh tracer, and no traced
+    /// path enters the cone.
+    #[test]
+    fn fixed_loop_paths_stay_and_close_the_cone() {
+        let s = shapes::icosphere(3);
+        let keep: Vec<[u32; 3]> =
+            s.faces().iter().filter(|f| !f.contains(&VertexId(0))).map(|f| [f[0].0, f[1].0, f[2].0]).collect();
+        let open = Mesh::from_triangles(s.positions().to_vec(), &keep).unwrap();
+        let c = cap_loops(&open).unwrap();
+        let lp = &c.loops[0];
+        let n = lp.vertices.len();
+        let far = VertexId::from_idx(200);
+        let anchors = vec![lp.vertices[0], lp.vertices[n / 3], lp.vertices[2 * n / 3], far, lp.apex];
+        let la = LoopAnchors { apex: 4, anchors: vec![0, 1, 2], vertices: lp.vertices.clone() };
+        let mut t = Tracer::new(&c.mesh, &anchors, &Default::default()).unwrap();
+        let paths = loop_paths(t.graph(), t.anchors(), std::slice::from_ref(&la)).unwrap();
+        assert_eq!(paths.len(), 6, "three segments and three spokes");
+        t.fix(paths.clone(), &c.cap_faces()).unwrap();
+        assert_eq!(t.n_fixed(), 6);
+        assert!(t.is_enclosed(4) && !t.is_enclosed(3));
+        assert!(t.linked_by_fixed(0, 1) && t.linked_by_fixed(4, 2) && !t.linked_by_fixed(0, 3));
+        // The apex is out of reach of every traced path.
+        assert!(t.trace(&TraceRequest { a: 3, b: 4, ..Default::default() }).unwrap().is_none());
+        let p = t.trace_insert(&TraceRequest { a: 3, b: 0, ..Default::default() }).unwrap().unwrap();
+        for w in t.paths()[p as usize].nodes.windows(2) {
+            if let Some((f, _, _)) = t.arc_face(w[0], w[1]) {
+                assert!(!c.is_cap_face(f), "a traced path crossed the cone");
+            }
+        }
+        straighten(&mut t, 3, &mut NoProgress).unwrap();
+        assert_eq!(&t.paths()[..6], &paths[..], "straightening leaves fixed paths alone");
+        let fresh = t.fresh().unwrap();
+        assert_eq!(fresh.paths(), &paths[..], "a fresh tracer holds the fixed paths only");
+    }
+}

@@ -9,14 +9,7 @@ use geom::progress::NoProgress;
 
 /// An icosphere with the faces around the given vertices removed: one loop per vertex.
 fn holed(holes: &[u32]) -> Mesh {
-    let s = shapes::icosphere(3);
-    let keep: Vec<[u32; 3]> = s
-        .faces()
-        .iter()
-        .filter(|f| !f.iter().any(|v| holes.contains(&v.0)))
-        .map(|f| [f[0].0, f[1].0, f[2].0])
-        .collect();
-    Mesh::from_triangles(s.positions().to_vec(), &keep).unwrap()
+    shapes::icosphere_with_holes(3, holes)
 }
 
 fn stretched(m: &Mesh) -> Mesh {

@@ -90,7 +90,7 @@ mod tests {
     use crate::domain::straighten::straighten;
     use crate::domain::tracer::{TraceRequest, Tracer};
     use crate::mesh::cap::cap_loops;
-    use crate::mesh::{Mesh, shapes};
+    use crate::mesh::shapes;
     use crate::progress::NoProgress;
 
     /// A holed icosphere closed by a cone, its loop cut by three anchors: the fixed paths run
@@ -98,10 +98,7 @@ mod tests {
     /// path enters the cone.
     #[test]
     fn fixed_loop_paths_stay_and_close_the_cone() {
-        let s = shapes::icosphere(3);
-        let keep: Vec<[u32; 3]> =
-            s.faces().iter().filter(|f| !f.contains(&VertexId(0))).map(|f| [f[0].0, f[1].0, f[2].0]).collect();
-        let open = Mesh::from_triangles(s.positions().to_vec(), &keep).unwrap();
+        let open = shapes::icosphere_with_holes(3, &[0]);
         let c = cap_loops(&open).unwrap();
         let lp = &c.loops[0];
         let n = lp.vertices.len();

@@ -1,4 +1,4 @@
-//! Meshes built in code, for tests and benchmarks: tetrahedron, icosphere, torus, grid disk,
+//! Meshes built in code, for tests and benchmarks: tetrahedron, icosphere (also with holes), torus, grid disk,
 //! and Loop-free midpoint subdivision (each triangle into four) of any mesh.
 
 use super::{Mesh, P3};
@@ -10,6 +10,15 @@ fn build(pos: Vec<P3>, tris: &[[u32; 3]]) -> Mesh {
         Ok(m) => m,
         Err(e) => panic!("shape construction failed: {e}"),
     }
+}
+
+/// An icosphere (`k` subdivisions) with the faces around each vertex of `around` removed: one
+/// boundary loop per vertex (they must lie at least two rings apart). Open-mesh tests use it.
+pub fn icosphere_with_holes(k: usize, around: &[u32]) -> Mesh {
+    let s = icosphere(k);
+    let keep: Vec<[u32; 3]> =
+        s.faces().iter().filter(|f| !f.iter().any(|v| around.contains(&v.0))).map(|f| f.map(|v| v.0)).collect();
+    build(s.positions().to_vec(), &keep)
 }
 
 /// A regular tetrahedron (genus 0, 4 vertices).

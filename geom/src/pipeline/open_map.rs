@@ -5,13 +5,13 @@
 //! The base-domain global map and optimization are closed-surface stages (they move images
 //! across layout paths, which here include the loops) and do not run.
 
-use super::common::{Artifact, Clock, PairReport, artifacts, json_artifact};
+use super::common::{Artifact, Clock, PairReport};
 use super::open_loops::OpenPlan;
 use super::spec::{MapOptions, Method};
-use super::voronoi::{Composed, LayoutMapReport, Pair, compose_layout};
+use super::voronoi::{Composed, LayoutMapReport, Pair, compose_layout, outputs};
 use crate::error::Result;
 use crate::mesh::{Mesh, VertexId};
-use crate::progress::{Progress, Stage};
+use crate::progress::Progress;
 
 /// Runs a `voronoi` or `greedy` job whose meshes have boundary loops.
 ///
@@ -35,7 +35,8 @@ pub(super) fn run(
     clock.lap("restrict");
     progress.check()?;
     let rev: Vec<(VertexId, VertexId)> = pairs.iter().map(|&(s, t)| (t, s)).collect();
-    // The loop anchors are held like the job's own; the apexes are not on the open meshes.
+    // The job's own anchors are held; the loop anchors and apexes are the layout's (boundary
+    // images stay on the boundary through relaxation in any case).
     let held = pairs.len();
     let pair = Pair { source, target, pairs, rev: &rev, sa: &sa[..held], ta: &ta[..held] };
     let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = pair.finish(maps, &o.relax(), &mut clock, progress)?;
@@ -44,13 +45,8 @@ pub(super) fn run(
     clock.lap("metrics");
     progress.check()?;
     let pr = PairReport::new(method.name(), pairs.len(), (source, target), (m1, m2), r1.merge(r2));
-    let mut report =
+    let report =
         LayoutMapReport { pair: pr, patches: patches.len(), layout: stats, global: None, optimize: None, boundaries };
-    let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, (&s2t, &t2s), &on_target, &on_source)?;
-    clock.lap("artifacts");
-    report.pair = report.pair.with_maps(s2t, t2s);
-    report.pair.timings_ms = clock.finish();
-    arts.push(json_artifact("metrics.json", &report)?);
-    progress.report(Stage::Done, 1.0);
-    Ok((report, arts))
+    let embedded = (&on_target, &on_source);
+    outputs(report, (&st, &tt, &patches, &rs, &rt), (s2t, t2s), embedded, clock, progress)
 }

@@ -11,7 +11,7 @@ use super::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
 use crate::crossparam::global::GlobalParamOptions;
 use crate::crossparam::smooth::SmoothReport;
 use crate::crossparam::{compose, parameterize_patches, parameterize_patches_with};
-use crate::domain::refine::refine;
+use crate::domain::refine::{Refined, refine};
 use crate::domain::tracer::Tracer;
 use crate::domain::{LayoutStats, greedy, patches_of, voronoi};
 use crate::error::{Error, InputError, Result};
@@ -227,8 +227,8 @@ pub(super) struct Composed<'m> {
     pub tt: Tracer<'m>,
     pub stats: LayoutStats,
     pub patches: Vec<crate::domain::Patch>,
-    pub rs: crate::domain::refine::Refined,
-    pub rt: crate::domain::refine::Refined,
+    pub rs: Refined,
+    pub rt: Refined,
     pub ps: Vec<crate::crossparam::PatchParam>,
     pub pt: Vec<crate::crossparam::PatchParam>,
     pub s2t: SurfaceMap,
@@ -373,7 +373,7 @@ fn run_with(
     progress.check()?;
     let metrics = (m1, m2);
     let pair = PairReport::new(method.name(), pairs.len(), (source, target), metrics, r1.merge(r2));
-    let mut report = LayoutMapReport {
+    let report = LayoutMapReport {
         pair,
         patches: patches.len(),
         layout: stats,
@@ -381,7 +381,23 @@ fn run_with(
         optimize: optimized,
         boundaries: Vec::new(),
     };
-    let mut arts = artifacts::map_artifacts(&st, &tt, &patches, &rs, &rt, (&s2t, &t2s), &on_target, &on_source)?;
+    outputs(report, (&st, &tt, &patches, &rs, &rt), (s2t, t2s), (&on_target, &on_source), clock, progress)
+}
+
+/// Every artifact and `metrics.json` of a finished `voronoi` / `greedy` job (closed or open
+/// meshes), with the maps kept in the report for the layout outputs.
+///
+/// # Errors
+/// `Error::Internal` if serialisation fails.
+pub(super) fn outputs(
+    mut report: LayoutMapReport,
+    (st, tt, patches, rs, rt): (&Tracer, &Tracer, &[crate::domain::Patch], &Refined, &Refined),
+    (s2t, t2s): (SurfaceMap, SurfaceMap),
+    (on_target, on_source): (&Mesh, &Mesh),
+    mut clock: Clock,
+    progress: &mut dyn Progress,
+) -> Result<(LayoutMapReport, Vec<Artifact>)> {
+    let mut arts = artifacts::map_artifacts(st, tt, patches, rs, rt, (&s2t, &t2s), on_target, on_source)?;
     clock.lap("artifacts");
     report.pair = report.pair.with_maps(s2t, t2s);
     report.pair.timings_ms = clock.finish();

@@ -46,7 +46,7 @@ pub(super) fn with_loop_anchors(
     target: &Mesh,
     (cs, ct): (Capped, Capped),
     pairs: &[(VertexId, VertexId)],
-    partner: &[Option<(usize, &'static str)>],
+    partner: &[(usize, &'static str)],
     mut corr: Vec<Vec<Corr>>,
 ) -> Result<OpenPlan> {
     let mut sa: Vec<VertexId> = pairs.iter().map(|p| p.0).collect();
@@ -54,7 +54,7 @@ pub(super) fn with_loop_anchors(
     let mut loop_anchor_ids: Vec<Vec<u32>> = Vec::new();
     let mut report = Vec::new();
     for (i, c) in corr.iter_mut().enumerate() {
-        let (j, by) = partner[i].expect("paired");
+        let (j, by) = partner[i];
         let (sl, tl) = (&cs.loops[i].vertices, &ct.loops[j].vertices);
         c.sort_by_key(|x| x.s);
         c.dedup_by_key(|x| x.s);
@@ -114,10 +114,9 @@ pub(super) fn with_loop_anchors(
             off_loop: [0, 0],
         });
     }
-    let held = sa.len();
     let (mut s_loops, mut t_loops) = (Vec::new(), Vec::new());
     for (i, ids) in loop_anchor_ids.into_iter().enumerate() {
-        let (j, _) = partner[i].expect("paired");
+        let (j, _) = partner[i];
         let apex = sa.len() as u32;
         sa.push(cs.loops[i].apex);
         ta.push(ct.loops[j].apex);
@@ -126,5 +125,5 @@ pub(super) fn with_loop_anchors(
     }
     let angles = [angle_sums(source), angle_sums(target)];
     let job_anchors = pairs.len();
-    Ok(OpenPlan { source: cs, target: ct, sa, ta, held, job_anchors, s_loops, t_loops, angles, report })
+    Ok(OpenPlan { source: cs, target: ct, sa, ta, job_anchors, s_loops, t_loops, angles, report })
 }

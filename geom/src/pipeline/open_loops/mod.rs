@@ -53,8 +53,6 @@ pub struct OpenPlan {
     /// Anchors on the closed meshes: the job's, then the added loop anchors, then the apexes.
     pub sa: Vec<VertexId>,
     pub ta: Vec<VertexId>,
-    /// Anchors held through relaxation on the open meshes (all but the apexes).
-    pub held: usize,
     /// The job's own anchors (the first of `sa` / `ta`).
     pub job_anchors: usize,
     s_loops: Vec<LoopAnchors>,
@@ -66,10 +64,6 @@ pub struct OpenPlan {
 
 fn name(l: &CapLoop) -> LoopName {
     LoopName { first_vertex: l.vertices[0].0, vertices: l.vertices.len() }
-}
-
-fn names(c: &Capped) -> Vec<LoopName> {
-    c.loops.iter().map(name).collect()
 }
 
 /// Equal boundary-loop counts, or `InputError::TopologyMismatch` naming each mesh's loops
@@ -108,17 +102,8 @@ impl OpenPlan {
         pairs: &[(VertexId, VertexId)],
         boundaries: &[(VertexId, VertexId)],
     ) -> Result<OpenPlan> {
+        check_loop_counts(source, target)?;
         let (cs, ct) = (cap_loops(source)?, cap_loops(target)?);
-        if cs.loops.len() != ct.loops.len() {
-            return Err(InputError::TopologyMismatch(format!(
-                "the source has {} boundary loops {:?}, the target {} {:?}: loops map one to one",
-                cs.loops.len(),
-                names(&cs),
-                ct.loops.len(),
-                names(&ct)
-            ))
-            .into());
-        }
         let (ls, lt) = (loop_of(&cs), loop_of(&ct));
         let nl = cs.loops.len();
         let mut partner: Vec<Option<(usize, &'static str)>> = vec![None; nl];
@@ -158,9 +143,13 @@ impl OpenPlan {
             corr[i].push(Corr { s: pos(&cs.loops[i], s), t: pos(&ct.loops[j], t), anchor: is_anchor.then_some(k) });
         }
         pair_by_nearest_anchor(source, target, &cs, &ct, pairs, &mut partner, &mut corr)?;
+        // Every loop has its partner now (the nearest-anchor pass fails otherwise).
+        let partner: Vec<(usize, &'static str)> = partner.into_iter().flatten().collect();
+        if partner.len() != nl {
+            return Err(crate::Error::Internal("a boundary loop was left unpaired".into()));
+        }
         let mut taken = vec![false; nl];
-        for (i, p) in partner.iter().enumerate() {
-            let (j, _) = p.expect("every loop paired");
+        for (i, &(j, _)) in partner.iter().enumerate() {
             if std::mem::replace(&mut taken[j], true) {
                 return Err(InputError::Anchors(format!(
                     "two source loops pair with target loop {:?} (source loop {:?} is one): list each loop once in boundaries",

@@ -10,6 +10,9 @@ use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, P3, VertexId};
 use crate::metrics::SurfaceIndex;
 
+/// Steps per side of the barycentric grid tried last (231 spots).
+const GRID: usize = 20;
+
 /// Moves hidden points; returns how many moved. With `reveal`, a point whose every visible
 /// spot counts more folds in its star still moves (to the least folded one): the folds were
 /// there, hidden with it, and the fold repairs that run next can now see them.
@@ -67,12 +70,24 @@ pub fn make_visible(
                 e
             })
             .collect();
-        let tries = cands.into_iter().map(|nb| (f, nb)).chain(
-            around
-                .into_iter()
-                .filter(|&g| g != f)
-                .flat_map(|g| std::iter::once((g, [1.0 / 3.0; 3])).chain(halfway.iter().map(move |&nb| (g, nb)))),
-        );
+        // Last, a grid over its own face, nearest spots first: the one spot that is both visible
+        // and fold-free can lie on an edge, off every ray above (seen on a vertex wedged at a
+        // corner of a long face, sweep case 0).
+        let mut grid: Vec<[f64; 3]> = (0..=GRID)
+            .flat_map(|i| (0..=GRID - i).map(move |j| [i, j, GRID - i - j].map(|k| k as f64 / GRID as f64)))
+            .collect();
+        let dist2 = |x: &[f64; 3]| (0..3).map(|k| (x[k] - b[k]).powi(2)).sum::<f64>();
+        grid.sort_by(|x, y| dist2(x).total_cmp(&dist2(y)));
+        let tries = cands
+            .into_iter()
+            .map(|nb| (f, nb))
+            .chain(
+                around
+                    .into_iter()
+                    .filter(|&g| g != f)
+                    .flat_map(|g| std::iter::once((g, [1.0 / 3.0; 3])).chain(halfway.iter().map(move |&nb| (g, nb)))),
+            )
+            .chain(grid.into_iter().map(|nb| (f, nb)));
         // The first visible spot that adds no fold; failing that, with `reveal`, the least folded
         // visible one: the hidden image was masking those folds (the rule read a wrong face's
         // normal), and the repairs that follow can see them once it is visible.

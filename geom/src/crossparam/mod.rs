@@ -11,6 +11,7 @@
 pub mod compose;
 pub mod foldover_free;
 pub mod global;
+pub mod on_surface;
 pub mod patch_param;
 pub mod planar_untangle;
 pub mod slide;

@@ -50,6 +50,9 @@ pub struct SmoothReport {
     pub rejected: usize,
     pub energy_before: f64,
     pub energy_after: f64,
+    /// Newton steps of the final optimization of the chords on the target
+    /// ([`super::on_surface`]), when kept.
+    pub chord_steps: usize,
 }
 
 impl SmoothReport {
@@ -63,6 +66,7 @@ impl SmoothReport {
             rejected: self.rejected + o.rejected,
             energy_before: self.energy_before + o.energy_before,
             energy_after: self.energy_after + o.energy_after,
+            chord_steps: self.chord_steps + o.chord_steps,
         }
     }
 }

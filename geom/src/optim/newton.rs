@@ -32,11 +32,16 @@ pub struct InjectiveNewtonOptions {
     pub tolerance: f64,
     /// The first trial step as a fraction of the first inversion time.
     pub step_fraction: f64,
+    /// Rounds per trial step in which the vertices of triangles the trial would invert are
+    /// held back (their step zeroed) before the step is halved; 0 halves at once. Where the
+    /// linear step bound cannot see an inversion (images retracted onto a curved surface), one
+    /// triangle would otherwise shorten every vertex's step.
+    pub hold_rounds: usize,
 }
 
 impl Default for InjectiveNewtonOptions {
     fn default() -> Self {
-        Self { max_iterations: 100, tolerance: 1e-6, step_fraction: 0.8 }
+        Self { max_iterations: 100, tolerance: 1e-6, step_fraction: 0.8, hold_rounds: 0 }
     }
 }
 
@@ -396,6 +401,9 @@ impl InjectiveNewton {
             return None;
         }
         let t = (opts.step_fraction * self.first_inversion(d, s, dir)).min(1.0);
+        if opts.hold_rounds > 0 {
+            return self.held_search(d, s, dir, t, energy, opts.hold_rounds);
+        }
         // The frozen metrics give the direction and the Armijo test; the step must also lower
         // the energy under the metrics where the trial lands (a long step crosses many target
         // faces, and the frozen energy alone let it wander uphill).
@@ -405,6 +413,59 @@ impl InjectiveNewton {
             }
             self.energy(d, trial).filter(|&e| e < energy && self.is_injective(d, trial))
         })
+    }
+}
+
+impl InjectiveNewton {
+    /// Triangles not positively oriented (exact predicate) in state `s`.
+    fn inverted<D: MapDomain>(&self, d: &D, s: &D::State) -> Vec<usize> {
+        let c = |p: Uv| robust::Coord { x: p[0], y: p[1] };
+        (0..self.triangles.len())
+            .filter(|&t| {
+                let [a, b, e] = d.element(s, self.triangles[t]).0;
+                robust::orient2d(c(a), c(b), c(e)) <= 0.0
+            })
+            .collect()
+    }
+
+    /// The line search with held vertices: a trial that inverts triangles is tried again at the
+    /// same length with their vertices held (up to `rounds` times), then halved. A trial is
+    /// accepted when every triangle is positive and the energy is lower.
+    fn held_search<D: MapDomain>(
+        &self,
+        d: &D,
+        s: &D::State,
+        dir: &[Uv],
+        mut t: f64,
+        energy: f64,
+        rounds: usize,
+    ) -> Option<(D::State, f64, usize)> {
+        let mut dir = dir.to_vec();
+        let mut refused = 0;
+        let mut held = 0;
+        while t > 1e-12 {
+            let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
+            if let Some(trial) = d.moved(s, &step) {
+                let bad = self.inverted(d, &trial);
+                if bad.is_empty() {
+                    if let Some(e) = self.energy(d, &trial).filter(|&e| e < energy) {
+                        return Some((trial, e, refused));
+                    }
+                } else if held < rounds {
+                    held += 1;
+                    refused += 1;
+                    for tri in bad {
+                        for v in self.triangles[tri] {
+                            dir[v as usize] = [0.0; 2];
+                        }
+                    }
+                    continue;
+                }
+            }
+            refused += 1;
+            t *= 0.5;
+        }
+        None
     }
 }
 

@@ -3,6 +3,7 @@
 //! boundary sliding, and the evaluator's metrics.
 
 use super::both;
+use crate::crossparam::on_surface::{OnSurfaceOptions, optimize_on_surface};
 use crate::crossparam::smooth::{self, SmoothReport};
 use crate::crossparam::untangle::{UntangleOptions, untangle};
 use crate::crossparam::visible::{evaluator_flip_count, make_visible, repair_flips};
@@ -13,6 +14,10 @@ use crate::metrics::{MapMetrics, MetricsOptions, evaluate_map};
 use crate::pipeline::spec::RelaxOptions;
 use crate::progress::{Progress, Stage};
 use crate::topology::SurfacePoint;
+
+/// Source meshes above this size skip the chord Newton stage (its line search walks every
+/// image per trial; at 58k vertices and more the sweeps alone are kept for time).
+pub const CHORD_NEWTON_MAX_VERTICES: usize = 60_000;
 
 /// One direction's relaxation: smoothing sweeps, visibility, fold repair, re-embedding and
 /// boundary sliding; `fixed` vertices (anchors, held feature vertices) stay put.
@@ -62,7 +67,37 @@ pub fn relax_direction(
             energy_after = energy;
         }
     }
-    Ok((m, SmoothReport { repaired, made_visible: v, reembedded: untangled.regions, energy_after, ..r }))
+    // Last, the whole map at once: projected Newton on the chords the evaluator measures,
+    // every chord kept unfolded; kept when the evaluator counts no more flipped faces.
+    let chord_steps = chord_newton(from, to, &mut m, fixed, progress)?;
+    Ok((m, SmoothReport { repaired, made_visible: v, reembedded: untangled.regions, energy_after, chord_steps, ..r }))
+}
+
+/// [`optimize_on_surface`] on a copy of `map`, kept when the evaluator counts no more flipped
+/// faces (a point the evaluator reads on another face than ours can differ); skipped above
+/// [`CHORD_NEWTON_MAX_VERTICES`]. Returns the Newton steps kept.
+fn chord_newton(
+    from: &Mesh,
+    to: &Mesh,
+    map: &mut SurfaceMap,
+    fixed: &[VertexId],
+    progress: &mut dyn Progress,
+) -> Result<usize> {
+    if from.n_vertices() > CHORD_NEWTON_MAX_VERTICES {
+        return Ok(0);
+    }
+    progress.report(Stage::Smooth, 0.9);
+    let mut cand = map.clone();
+    let r = optimize_on_surface(from, to, &mut cand, fixed, &OnSurfaceOptions::default(), &*progress)?;
+    if r.iterations == 0 {
+        return Ok(0);
+    }
+    make_visible(from, to, &mut cand, fixed, false)?;
+    if evaluator_flip_count(from, to, &cand)? > evaluator_flip_count(from, to, map)? {
+        return Ok(0);
+    }
+    *map = cand;
+    Ok(r.iterations)
 }
 
 /// One more relaxation of `map` after repairs: smoothing sweeps, hidden points revealed and

@@ -154,8 +154,9 @@ fn spot_glb_with_seams_maps_and_morph_keeps_its_layout() {
         sorted[sorted.len() - 1]
     );
     // The transfer itself is exact (geom/tests/transfer.rs); here the map's own error on a
-    // retriangulated copy bounds it (0.0028 measured; the issue asks 1e-3, see bench/NOTES.md).
-    assert!(mean <= 5e-3, "mean UV error {mean} over {} vertices", errs.len());
+    // retriangulated copy bounds it (5.5e-5 measured with the chord Newton stage, 0.0028
+    // before it; issue 34 asks 1e-3).
+    assert!(mean <= 1e-3, "mean UV error {mean} over {} vertices", errs.len());
 }
 
 /// `options.inverse_morph`: `morph.glb` holds two nodes, the source with a morph onto the target

@@ -30,8 +30,8 @@ pub struct OnSurface<'a> {
     normals: Vec<V3>,
     /// An orthonormal tangent basis per target face.
     frames: Vec<[V3; 2]>,
-    /// Chords are scaled by this (the source's area over the target's, square-rooted), as the
-    /// evaluator scales the mapped mesh before measuring.
+    /// Chords are scaled by this (the source's area over the start map's chord area,
+    /// square-rooted), as the evaluator scales the mapped mesh before measuring.
     scale: f64,
 }
 
@@ -44,7 +44,7 @@ pub struct Images {
 }
 
 impl<'a> OnSurface<'a> {
-    pub fn new(source: &Mesh, target: &'a Mesh) -> Self {
+    pub fn new(source: &Mesh, target: &'a Mesh, start: &crate::map::SurfaceMap) -> Self {
         let normals: Vec<V3> = (0..target.n_faces())
             .map(|f| {
                 let n = target.face_normal_raw(FaceId::from_idx(f));
@@ -62,7 +62,13 @@ impl<'a> OnSurface<'a> {
                 [u, n.cross(&u)]
             })
             .collect();
-        let scale = (source.area() / target.area().max(f64::MIN_POSITIVE)).sqrt();
+        let pos: Vec<P3> = (0..start.len()).map(|v| start.position(VertexId::from_idx(v), target)).collect();
+        let chords: f64 = source
+            .faces()
+            .iter()
+            .map(|f| 0.5 * (pos[f[1].idx()] - pos[f[0].idx()]).cross(&(pos[f[2].idx()] - pos[f[0].idx()])).norm())
+            .sum();
+        let scale = (source.area() / chords.max(f64::MIN_POSITIVE)).sqrt();
         Self { target, normals, frames, scale }
     }
 
@@ -264,7 +270,7 @@ pub fn optimize_on_surface(
     held.extend(
         (0..source.n_vertices()).filter(|&v| source.is_boundary_vertex(VertexId::from_idx(v))).map(|v| v as u32),
     );
-    let domain = OnSurface::new(source, target);
+    let domain = OnSurface::new(source, target, map);
     let mut s = domain.images(map);
     // Chords that start folded (or on an edge or corner where the evaluator may see them so)
     // are held as they are, corners and all, and left out: every other chord stays positive.

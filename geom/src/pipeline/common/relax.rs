@@ -74,7 +74,8 @@ pub fn relax_direction(
 }
 
 /// [`optimize_on_surface`] on a copy of `map`, kept when the evaluator counts no more flipped
-/// faces (a point the evaluator reads on another face than ours can differ); skipped above
+/// faces (a point the evaluator reads on another face than ours can differ) and the L2 stretch
+/// is not higher; skipped above
 /// [`CHORD_NEWTON_MAX_VERTICES`]. Returns the Newton steps kept.
 fn chord_newton(
     from: &Mesh,
@@ -93,7 +94,10 @@ fn chord_newton(
         return Ok(0);
     }
     make_visible(from, to, &mut cand, fixed, false)?;
-    if evaluator_flip_count(from, to, &cand)? > evaluator_flip_count(from, to, map)? {
+    // The energy is symmetric Dirichlet; the stretch the evaluator reports can rise where it
+    // trades stretch for compression (seen: SMPL with 12 anchors), and then the map stays.
+    let l2 = |m: &SurfaceMap| -> Result<f64> { Ok(crate::metrics::distortion(from, &m.embed(from, to)?).l2_stretch) };
+    if evaluator_flip_count(from, to, &cand)? > evaluator_flip_count(from, to, map)? || l2(&cand)? > l2(map)? {
         return Ok(0);
     }
     *map = cand;

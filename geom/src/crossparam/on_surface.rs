@@ -1,9 +1,10 @@
 //! A map's images optimized on the target surface itself, measured as the shared evaluator
 //! measures them: each source triangle against the straight (chord) triangle through its three
 //! images. Every source vertex's image is a point of the target (face, barycentric
-//! coordinates); it moves in its face's tangent plane and is carried back onto the surface by a
-//! closest-point search over the faces around it (a retraction, as in the tangent-space steps of
-//! Schmidt, Pieper & Kobbelt 2023, here on the target mesh instead of a sphere).
+//! coordinates); a step in its face's tangent plane walks along the surface, straight across
+//! each edge with the rest of the step unfolded into the next face (a retraction, as in the
+//! tangent-space steps of Schmidt, Pieper & Kobbelt 2023, here on the target mesh instead of a
+//! sphere).
 //!
 //! A chord is measured in its own plane and counts as inverted when it faces against the target
 //! faces under all three of its corners, which is the evaluator's flip rule without its fourth
@@ -56,6 +57,9 @@ impl<'a> OnSurface<'a> {
             .map(|f| {
                 let [a, b, _] = target.face_points(FaceId::from_idx(f));
                 let n = normals[f];
+                if n == V3::zeros() {
+                    return [V3::x(), V3::y()];
+                }
                 let e = b - a;
                 let u = e - n * e.dot(&n);
                 let u = if u.norm() > 0.0 { u.normalize() } else { perpendicular(&n) };
@@ -338,5 +342,39 @@ mod tests {
         assert!(r.energy_after < r.energy_before);
         assert!(r.energy_after < 1.001, "{r:?}");
         assert!(err(&map) < 0.1 * before);
+    }
+
+    /// A start with folded chords: they are held, corners and all, and the rest is optimized
+    /// without a fold more (the evaluator's count).
+    #[test]
+    fn folded_chords_are_held_and_no_fold_is_added() {
+        let mesh = shapes::icosphere(3);
+        let mut map = SurfaceMap::identity(&mesh);
+        // Vertex 50's image moved onto its farthest neighbour's far side: its star folds.
+        let v = VertexId::from_idx(50);
+        let far = mesh.vertex_neighbors(v).next().unwrap();
+        let beyond = mesh.position(far) + (mesh.position(far) - mesh.position(v)) * 0.5;
+        let loc = crate::topology::Locator::new(&mesh).unwrap();
+        let pr = loc.project(&P3::from(beyond.coords.normalize()));
+        map.face[50] = pr.face;
+        map.bary[50] = pr.bary;
+        let flips = |m: &SurfaceMap| crate::crossparam::visible::evaluator_flip_count(&mesh, &mesh, m).unwrap();
+        let before = flips(&map);
+        assert!(before > 0);
+        let start = map.clone();
+        let r = optimize_on_surface(
+            &mesh,
+            &mesh,
+            &mut map,
+            &[VertexId::from_idx(0)],
+            &OnSurfaceOptions::default(),
+            &NoProgress,
+        )
+        .unwrap();
+        assert!(r.folded_at_start > 0, "{r:?}");
+        assert!(flips(&map) <= before);
+        // Vertex 50, a corner of every folded chord, did not move; the rest relaxed.
+        assert_eq!((map.face[50], map.bary[50]), (start.face[50], start.bary[50]));
+        assert!(r.iterations > 0 && r.energy_after < r.energy_before, "{r:?}");
     }
 }

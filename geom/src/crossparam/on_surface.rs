@@ -284,9 +284,16 @@ pub fn optimize_on_surface(
     };
     let (keep, out): (Vec<usize>, Vec<usize>) = (0..tris.len()).partition(|&i| positive(&tris[i]));
     held.extend(out.iter().flat_map(|&i| tris[i]));
+    // A vertex left without a kept triangle has nothing to lower: held too.
+    let mut in_kept = vec![false; source.n_vertices()];
+    keep.iter().flat_map(|&i| tris[i]).for_each(|v| in_kept[v as usize] = true);
+    held.extend((0..source.n_vertices() as u32).filter(|&v| !in_kept[v as usize]));
     held.sort_unstable();
     held.dedup();
     let mut r = OnSurfaceResult { folded_at_start: out.len(), ..Default::default() };
+    if held.len() == source.n_vertices() {
+        return Ok(r);
+    }
     let tris: Vec<[u32; 3]> = keep.iter().map(|&i| tris[i]).collect();
     let rest: Vec<RestTriangle> = keep.iter().map(|&i| rest[i]).collect();
     let newton = InjectiveNewton::new(source.n_vertices(), tris, rest, &held)?;

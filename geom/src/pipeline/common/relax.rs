@@ -7,7 +7,7 @@ use crate::crossparam::on_surface::{OnSurfaceOptions, optimize_on_surface};
 use crate::crossparam::smooth::{self, SmoothReport};
 use crate::crossparam::untangle::{UntangleOptions, untangle};
 use crate::crossparam::visible::{evaluator_flip_count, make_visible, repair_flips};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
 use crate::metrics::{MapMetrics, MetricsOptions, evaluate_map};
@@ -89,7 +89,16 @@ fn chord_newton(
     }
     progress.report(Stage::Smooth, 0.9);
     let mut cand = map.clone();
-    let r = optimize_on_surface(from, to, &mut cand, fixed, &OnSurfaceOptions::default(), &*progress)?;
+    // A Newton system the solver cannot take (chords near degenerate) ends the stage, not the
+    // job: the relaxed map stands, and is measured and checked as it is.
+    let r = match optimize_on_surface(from, to, &mut cand, fixed, &OnSurfaceOptions::default(), &*progress) {
+        Ok(r) => r,
+        Err(Error::Cancelled) => return Err(Error::Cancelled),
+        Err(e) => {
+            tracing::debug!(error = %e, "chord Newton stopped");
+            return Ok(0);
+        }
+    };
     if r.iterations == 0 {
         return Ok(0);
     }

@@ -464,8 +464,8 @@ mod tests {
 
     /// The base-domain optimization stage (gate opened) on an icosphere onto a stretched copy:
     /// both directions come out without a flip, anchors exact, lower in energy than the
-    /// per-patch composition it starts from and less distorted after the same relaxation; a
-    /// gate above the maps' energy skips the stage.
+    /// per-patch composition it starts from and no more distorted after the same relaxation;
+    /// a gate above the maps' energy skips the stage.
     #[test]
     fn the_domain_optimization_maps_both_ways_without_flips() {
         let s = shapes::icosphere(3);
@@ -493,9 +493,11 @@ mod tests {
         for (m, p) in pairs {
             assert_eq!(m.flipped_faces, 0);
             assert!(m.anchor_error_max.unwrap() <= 1e-9, "{:?}", m.anchor_error_max);
+            // The chord Newton stage at the end of the relaxation takes both to the same
+            // minimum here; the optimized start must not end above the per-patch one.
             assert!(
-                m.l2_stretch < p.l2_stretch,
-                "optimized L2 {} not below the per-patch {}",
+                m.l2_stretch <= p.l2_stretch * (1.0 + 1e-9),
+                "optimized L2 {} above the per-patch {}",
                 m.l2_stretch,
                 p.l2_stretch
             );

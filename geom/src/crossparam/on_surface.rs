@@ -15,6 +15,7 @@ use crate::mesh::{FaceId, Mesh, P3, V3, VertexId};
 use crate::optim::newton::MapDomain;
 use crate::optim::sym_dirichlet::Mat2;
 use crate::param::Uv;
+use crate::topology::plane_barycentric;
 
 /// A barycentric coordinate this close to zero puts a point on an edge for the flip rule.
 const TIE: f64 = 1e-12;
@@ -107,7 +108,7 @@ impl<'a> OnSurface<'a> {
     fn walk(&self, mut f: FaceId, mut p: P3, mut d: V3) -> Option<(FaceId, [f64; 3], P3)> {
         for _ in 0..MAX_CROSSINGS {
             let tri = self.target.face_points(f);
-            let (bp, bq) = (plane_bary(tri, p), plane_bary(tri, p + d));
+            let (bp, bq) = (plane_barycentric(tri, p), plane_barycentric(tri, p + d));
             // The first edge the segment leaves through: corner k's coordinate reaching zero.
             let mut exit: Option<(f64, usize)> = None;
             for k in 0..3 {
@@ -126,7 +127,7 @@ impl<'a> OnSurface<'a> {
             let x = p + d * s;
             let h = crate::mesh::HalfedgeId::of(f, (k + 1) % 3);
             let Some(t) = self.target.twin(h) else {
-                return Some((f, clamp_bary(plane_bary(tri, x)), x));
+                return Some((f, clamp_bary(plane_barycentric(tri, x)), x));
             };
             let g = t.face();
             let e = (tri[(k + 2) % 3] - tri[(k + 1) % 3]).normalize();
@@ -200,20 +201,6 @@ fn perpendicular(n: &V3) -> V3 {
 
 fn coord(p: Uv) -> robust::Coord<f64> {
     robust::Coord { x: p[0], y: p[1] }
-}
-
-/// Unclamped barycentric coordinates of `q` projected into the plane of triangle `t`.
-fn plane_bary(t: [P3; 3], q: P3) -> [f64; 3] {
-    let (e1, e2, d) = (t[1] - t[0], t[2] - t[0], q - t[0]);
-    let (a, b, c) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
-    let (r1, r2) = (e1.dot(&d), e2.dot(&d));
-    let det = a * c - b * b;
-    if det <= 0.0 {
-        return [1.0, 0.0, 0.0];
-    }
-    let v = (c * r1 - b * r2) / det;
-    let w = (a * r2 - b * r1) / det;
-    [1.0 - v - w, v, w]
 }
 
 /// Barycentric coordinates clipped to the triangle and renormalized.

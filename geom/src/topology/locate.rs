@@ -81,6 +81,15 @@ impl Locator {
 
 /// Barycentric coordinates of `q` (on or near triangle `t`), clamped to the triangle.
 fn barycentric(t: [P3; 3], q: P3) -> [f64; 3] {
+    let [_, v, w] = plane_barycentric(t, q);
+    let v = v.clamp(0.0, 1.0);
+    let w = w.clamp(0.0, 1.0 - v);
+    [1.0 - v - w, v, w]
+}
+
+/// Unclamped barycentric coordinates of `q` projected into the plane of triangle `t`
+/// (`[1, 0, 0]` for a degenerate triangle).
+pub(crate) fn plane_barycentric(t: [P3; 3], q: P3) -> [f64; 3] {
     let (e1, e2, d) = (t[1] - t[0], t[2] - t[0], q - t[0]);
     let (a, b, c) = (e1.dot(&e1), e1.dot(&e2), e2.dot(&e2));
     let (r1, r2) = (e1.dot(&d), e2.dot(&d));
@@ -88,8 +97,8 @@ fn barycentric(t: [P3; 3], q: P3) -> [f64; 3] {
     if det <= 0.0 {
         return [1.0, 0.0, 0.0];
     }
-    let v = ((c * r1 - b * r2) / det).clamp(0.0, 1.0);
-    let w = ((a * r2 - b * r1) / det).clamp(0.0, 1.0 - v);
+    let v = (c * r1 - b * r2) / det;
+    let w = (a * r2 - b * r1) / det;
     [1.0 - v - w, v, w]
 }
 

@@ -7,6 +7,7 @@ mod loops;
 mod surface_point;
 
 pub use components::{Components, PartSummary, components, parts};
+pub(crate) use locate::plane_barycentric;
 pub use locate::{Locator, Projection};
 pub use loops::boundary_loops;
 pub use surface_point::SurfacePoint;

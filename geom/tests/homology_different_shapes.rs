@@ -16,7 +16,12 @@ fn run(s: &Mesh, t: &Mesh, basis: [usize; 2], rotation: usize) -> HomologyMapRep
     let spec = HomologySpec {
         features: Vec::new(),
         anchors: geom::pipeline::AnchorRow::ids(vec![[0, 0]]),
-        options: HomologyOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
+        options: HomologyOptions {
+            metric_samples: 5000,
+            rotation: Some(rotation),
+            basis: Some(basis),
+            ..Default::default()
+        },
     };
     run_map(&spec, s, t, &mut NoProgress).unwrap().0
 }
@@ -52,7 +57,7 @@ fn kitten_to_rocker_arm_in_two_homotopy_classes_without_flips() {
         let spec = HomologySpec {
             features: Vec::new(),
             anchors: geom::pipeline::AnchorRow::ids(vec![[0, 0]]),
-            options: HomologyOptions { metric_samples: 5000, rotation, ..Default::default() },
+            options: HomologyOptions { metric_samples: 5000, rotation: Some(rotation), ..Default::default() },
         };
         let (r, arts) = run_map(&spec, &s, &t, &mut NoProgress).unwrap();
         for m in [&r.pair.source_to_target, &r.pair.target_to_source] {

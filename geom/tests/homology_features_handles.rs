@@ -61,7 +61,12 @@ fn run_with(
     basis: [usize; 2],
     rotation: usize,
 ) -> Run {
-    let sp = job(s, gt, (c, tc), HomologyOptions { metric_samples: 5000, basis, rotation, ..Default::default() });
+    let sp = job(
+        s,
+        gt,
+        (c, tc),
+        HomologyOptions { metric_samples: 5000, basis: Some(basis), rotation: Some(rotation), ..Default::default() },
+    );
     let (report, arts) = run_map(&sp, s, t, &mut NoProgress).unwrap();
     common::assert_artifacts(
         &arts,

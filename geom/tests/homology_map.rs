@@ -26,7 +26,12 @@ fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, bas
     let spec = HomologySpec {
         features: Vec::new(),
         anchors: AnchorRow::ids(anchors.iter().map(|&a| [a as u64, gt[a as usize] as u64])),
-        options: HomologyOptions { metric_samples: 5000, rotation, basis, ..Default::default() },
+        options: HomologyOptions {
+            metric_samples: 5000,
+            rotation: Some(rotation),
+            basis: Some(basis),
+            ..Default::default()
+        },
     };
     let (report, arts) = match run_map(&spec, s, t, &mut NoProgress) {
         Ok(x) => x,
@@ -219,4 +224,56 @@ fn a_curve_matching_selects_its_class() {
     let e = run_map(&job(&["a1 -> b1", "b1 -> a1"]), &s, &t, &mut NoProgress).unwrap_err();
     assert_eq!(e.code(), "invalid_spec", "{e}");
     assert!(e.to_string().contains("symplectic"), "{e}");
+}
+
+/// The job with no class named, as [`run`] with one.
+fn run_natural(s: &Mesh, t: &Mesh, gt: &[u32]) -> Run {
+    let spec = HomologySpec {
+        features: Vec::new(),
+        anchors: AnchorRow::ids([[0, gt[0] as u64]]),
+        options: HomologyOptions { metric_samples: 5000, ..Default::default() },
+    };
+    let (report, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();
+    let mapped = common::source_on_target(&arts, s, t);
+    let gt_mean =
+        mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(gt[i]))).norm()).sum::<f64>()
+            / mapped.n_vertices() as f64
+            / t.area().sqrt();
+    Run { report, gt_mean }
+}
+
+/// With no class named, the job finds the true one where basis 0 and τ = 0 are not it (the
+/// subdivided genus-2 copy needs basis 1 on both meshes, see above; the bent genus-3 slab
+/// another pair), and lists every class it found, the chosen one first and relaxed fold-free,
+/// each class once.
+#[test]
+fn the_natural_class_by_default() {
+    let s = load("eight_lowres.off");
+    let t = subdivided(&s);
+    let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
+    let cases = [("eight_lowres subdivided", s, t, gt), {
+        let s = load("3holes.off");
+        let t = bent(&s);
+        let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
+        ("3holes bent", s, t, gt)
+    }];
+    for (what, s, t, gt) in &cases {
+        let r = run_natural(s, t, gt);
+        assert_clean(&r, what);
+        let h = &r.report.homology;
+        let c = h.candidates.as_ref().expect("candidates listed");
+        assert!(c.len() >= 2, "{what}: {c:?}");
+        assert_eq!((c[0].class.basis, c[0].class.rotation), (h.basis, h.rotation), "{what}: chosen first");
+        assert_eq!(c[0].flips, Some([0, 0]), "{what}: {c:?}");
+        assert_eq!(h.h1_reference.as_ref(), Some(&c[0].class.h1_reference), "{what}");
+        for i in 0..c.len() {
+            for j in 0..i {
+                assert_ne!(c[i].class.h1_reference, c[j].class.h1_reference, "{what}: one candidate per class");
+            }
+        }
+        // Not relaxed means not needed: only after the relaxed ones, least stretched first.
+        let unrelaxed: Vec<f64> = c.iter().filter(|x| x.flips.is_none()).map(|x| x.class.stretch).collect();
+        assert!(unrelaxed.windows(2).all(|w| w[0] <= w[1]), "{what}: {c:?}");
+        assert!(c.iter().skip_while(|x| x.flips.is_some()).all(|x| x.flips.is_none()), "{what}: {c:?}");
+    }
 }

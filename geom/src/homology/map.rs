@@ -102,21 +102,34 @@ pub fn homology_map(
         let s = side(source, bases.0, 0, 0);
         (s, h.join())
     });
-    let (mut s, mut t) = (s?, t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??);
-    // Both meshes refined alike: the one found earlier is searched again up to the other's
-    // attempt, so that the same shape is cut by the same loops.
+    let (s, t) = (s?, t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??);
+    let (s, t) = aligned((s, t), &mut |min| side(source, bases.0, 0, min), &mut |min| side(target, bases.1, 1, min))?;
+    map_between(source, target, s, t, opts.rotation, anchors)
+}
+
+/// Both meshes refined alike: the side found at an earlier attempt is searched again up to the
+/// other's attempt (`again_s(min_attempt)`, `again_t`), so that one shape is cut by the same
+/// loops on both meshes.
+///
+/// # Errors
+/// What the searches report.
+pub fn aligned(
+    (mut s, mut t): (SideDomain, SideDomain),
+    again_s: &mut dyn FnMut(usize) -> Result<SideDomain>,
+    again_t: &mut dyn FnMut(usize) -> Result<SideDomain>,
+) -> Result<(SideDomain, SideDomain)> {
     for _ in 0..3 {
         let (a, b) = (s.basis.attempt, t.basis.attempt);
         if a == b {
             break;
         }
         if a < b {
-            s = side(source, bases.0, 0, b)?;
+            s = again_s(b)?;
         } else {
-            t = side(target, bases.1, 1, a)?;
+            t = again_t(a)?;
         }
     }
-    map_between(source, target, s, t, opts.rotation, anchors)
+    Ok((s, t))
 }
 
 /// Composes two sides' domains under rotation `rotation`.

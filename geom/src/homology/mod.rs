@@ -13,6 +13,7 @@
 //! - [`domain`]: the cut disk on the regular 4g-gon.
 //! - [`map`]: maps both ways through the two domains, rotation τ, induced map on H1.
 //! - [`matching`]: an explicit curve matching (`a1 -> b1`, …) realized by basis and rotation.
+//! - [`natural`]: the classes reachable by bases and rotations, least stretched first.
 //! - [`compose`]: two planar disks composed into maps, the interior anchor warp.
 //! - [`overlay`]: the meta-mesh, both tessellations merged.
 //! - [`prune`]: the meta-mesh reduced to the edges needed above a dihedral-angle threshold.
@@ -36,6 +37,7 @@ pub mod feature_overlay;
 pub mod features;
 pub mod map;
 pub mod matching;
+pub mod natural;
 pub mod overlay;
 pub mod prune;
 pub mod search;

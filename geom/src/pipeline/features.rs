@@ -6,7 +6,7 @@
 use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
 use super::common::relax::finish_pair;
 use super::common::{Artifact, Clock, PairReport, artifacts, json_artifact};
-use super::spec::HomologySpec;
+use super::spec::{ClassChoice, HomologySpec};
 use crate::error::Result;
 use crate::homology::CanonicalBasisResult;
 use crate::homology::curve_align::CurveAlignOptions;
@@ -82,12 +82,18 @@ pub fn run(
     let o = &spec.options;
     clock.lap("setup");
     progress.report(Stage::FeatureCut, 0.0);
+    // Feature curves pin most of the class: with none named it is basis 0 and τ = 0 (the
+    // natural-class search is for jobs without curves).
+    let (basis, rotation) = match o.class_choice() {
+        ClassChoice::Explicit { basis, rotation } => (basis, rotation),
+        ClassChoice::Natural | ClassChoice::Matching(_) => ([0, 0], 0),
+    };
     let fo = FeatureMapOptions {
         // As in `homology`: no reweighting of the planar domains.
         stretch_iterations: 0,
         align: o.align_curves.then(CurveAlignOptions::default),
-        basis: o.basis,
-        rotation: o.rotation,
+        basis,
+        rotation,
         max_subdivisions: None,
     };
     let r = feature_map(source, target, curves.0, curves.1, pairs, &fo)?;
@@ -126,7 +132,7 @@ pub fn run(
         kinds: r.source.cut.curves.iter().map(|c| c.kind).collect(),
         genus: r.handles.as_ref().map_or(0, |h| h.source.genus()),
         doubled_genus: r.source.cut.doubled_genus,
-        h1: r.handles.as_ref().map(|h| crate::homology::map::induced_h1_for(&h.source, &h.target, o.rotation)),
+        h1: r.handles.as_ref().map(|h| crate::homology::map::induced_h1_for(&h.source, &h.target, rotation)),
         side_shift: r.handles.as_ref().map(|h| h.side_shift),
         word: word(&r.source.cut, r.handles.as_ref().map(|h| &h.source)),
         feature_error: [feature_error(&f.s2t, target, sc, tc), feature_error(&f.t2s, source, tc, sc)],

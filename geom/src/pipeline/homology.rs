@@ -1,15 +1,16 @@
-//! `homology` without feature curves: canonical bases -> fundamental domains -> maps through
-//! the 4g-gon -> anchor snapping -> relaxation -> metrics -> artifacts (bases and domains
-//! included).
+//! `homology` without feature curves: the class (named, or the natural search's candidates)
+//! -> canonical bases -> fundamental domains -> maps through the 4g-gon -> anchor snapping ->
+//! relaxation -> metrics -> artifacts (bases and domains included).
 
 use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
-use super::common::relax::finish_pair;
+use super::common::relax::{FinishedPair, finish_pair};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
+use super::homology_class::{CandidateReport, ClassPlan, Relaxed, candidate_reports};
 use super::spec::HomologySpec;
 use crate::error::{Error, Result};
 use crate::homology::map::SideDomain;
-use crate::homology::matching::{MatchingOptions, find_matching, parse_matching, reference_frame, reference_h1};
-use crate::homology::{HomologyMapOptions, homology_map};
+use crate::homology::matching::{reference_frame, reference_h1};
+use crate::homology::{HomologyMapOptions, HomologyMapResult, homology_map};
 use crate::mesh::Mesh;
 use crate::progress::{Progress, Stage};
 use serde::Serialize;
@@ -39,6 +40,10 @@ pub struct HomologyReport {
     /// used or a matching was asked for.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub h1_reference: Option<Vec<Vec<i32>>>,
+    /// With no class named: every class found, best first (the chosen one, the others
+    /// relaxed, then the rest by stretch before relaxation).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub candidates: Option<Vec<CandidateReport>>,
     /// Base vertices (the first anchor pair).
     pub base: [u32; 2],
     /// Subdivision rounds the bases needed.
@@ -66,50 +71,63 @@ pub fn run(
     let o = &spec.options;
     clock.lap("setup");
     progress.report(Stage::Basis, 0.0);
-    let (mut basis, mut rotation, mut want) = (o.basis, o.rotation, None);
-    if let Some(entries) = &o.matching {
-        let g = crate::topology::summary(source).genus.max(0) as usize;
-        let w = parse_matching(g, entries)?;
-        let found = find_matching(source, target, pairs[0], &w, &MatchingOptions::default())?;
-        (basis, rotation, want) = (found.basis, found.rotation, Some(w));
-        clock.lap("matching");
+    let plan = ClassPlan::new(o.class_choice(), source, target, &pairs, progress)?;
+    clock.lap("classes");
+    // Each class in the plan is built and relaxed in turn: the close ones all, the others while
+    // none is fold-free; the least folded, then least stretched, stands.
+    let mut relaxed: Vec<Relaxed> = Vec::new();
+    let mut best: Option<(usize, HomologyMapResult, FinishedPair)> = None;
+    for (i, &(basis, rotation)) in plan.tries.iter().enumerate() {
+        let hopts = HomologyMapOptions {
+            basis,
+            rotation,
+            max_subdivisions: None,
+            // Reweighting each domain on its own lowers each map's stretch but raised the
+            // composed map's folds on every different-shape pair measured (bench/NOTES.md).
+            stretch_iterations: 0,
+        };
+        let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
+        progress.check()?;
+        let f = finish_pair(
+            source,
+            target,
+            (&r.source_to_target, &r.target_to_source),
+            &pairs,
+            (&[], &[]),
+            &o.relax(),
+            progress,
+        )?;
+        let out =
+            Relaxed { flips: [f.m1.flipped_faces, f.m2.flipped_faces], l2_stretch: [f.m1.l2_stretch, f.m2.l2_stretch] };
+        relaxed.push(out);
+        if best.as_ref().is_none_or(|(b, ..)| out.better_than(&relaxed[*b])) {
+            best = Some((i, r, f));
+        }
+        if i + 1 >= plan.compare && relaxed.iter().any(|r| r.flips == [0, 0]) {
+            break;
+        }
     }
-    let hopts = HomologyMapOptions {
-        basis,
-        rotation,
-        max_subdivisions: None,
-        // Reweighting each domain on its own lowers each map's stretch but raised the composed
-        // map's folds on every different-shape pair measured (bench/NOTES.md).
-        stretch_iterations: 0,
-    };
-    let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
-    // The induced map read in the reference bases (basis 0 on each mesh), when the bases used
-    // are others or a matching was asked for.
-    let h1_reference = if want.is_some() || basis != [0, 0] {
+    let (chosen, r, f) = best.ok_or_else(|| Error::Internal("homology: no class to relax".into()))?;
+    let (basis, rotation) = plan.tries[chosen];
+    // The induced map read in the reference bases (basis 0 on each mesh): the search's, or
+    // computed when other bases were used or a matching was asked for.
+    let h1_reference = if let Some(c) = plan.candidates.get(chosen) {
+        Some(c.h1_reference.clone())
+    } else if plan.want.is_some() || basis != [0, 0] {
         let (fs, ft) = both(|| reference_frame(target, pairs[0].1), || reference_frame(source, pairs[0].0))?;
         let (fs, ft) = (fs?, ft?);
         Some(reference_h1((source, target), (&fs.1, &ft.1), (&r.source.basis, &r.target.basis), &r.h1)?)
     } else {
         None
     };
-    if let (Some(w), Some(got)) = (&want, &h1_reference)
+    if let (Some(w), Some(got)) = (&plan.want, &h1_reference)
         && got != w
     {
         return Err(Error::Numerical(format!(
             "matching: the bases refined for the map induce {got:?} instead of {w:?}"
         )));
     }
-    clock.lap("basis_domain_map");
-    progress.check()?;
-    let f = finish_pair(
-        source,
-        target,
-        (&r.source_to_target, &r.target_to_source),
-        &pairs,
-        (&[], &[]),
-        &o.relax(),
-        progress,
-    )?;
+    let candidates = (!plan.candidates.is_empty()).then(|| candidate_reports(&plan, &relaxed, chosen));
     clock.lap("smooth_metrics");
     progress.check()?;
     let g = r.source.basis.genus();
@@ -141,6 +159,7 @@ pub fn run(
         anchor_warp: r.warped,
         h1: r.h1.clone(),
         h1_reference,
+        candidates,
         base: [pairs[0].0.0, pairs[0].1.0],
         subdivisions: [r.source.basis.subdivisions, r.target.basis.subdivisions],
         loop_lengths: [len(&r.source), len(&r.target)],

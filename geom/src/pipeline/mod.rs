@@ -14,6 +14,7 @@ pub mod features;
 mod folds;
 mod global_choice;
 pub mod homology;
+pub mod homology_class;
 mod input_ids;
 mod layout_outputs;
 mod limits;

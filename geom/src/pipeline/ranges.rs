@@ -72,9 +72,13 @@ impl HomologyOptions {
     /// # Errors
     /// `InputError::OptionRange` naming the first field out of range and the range.
     pub fn check_ranges(&self) -> Result<()> {
-        size("basis[0]", self.basis[0], 0, 64)?;
-        size("basis[1]", self.basis[1], 0, 64)?;
-        size("rotation", self.rotation, 0, 1_000)?;
+        if let Some([s, t]) = self.basis {
+            size("basis[0]", s, 0, 64)?;
+            size("basis[1]", t, 0, 64)?;
+        }
+        if let Some(r) = self.rotation {
+            size("rotation", r, 0, 1_000)?;
+        }
         super::transfer_output::parse(&self.transfer)?;
         if let Some(d) = self.dihedral_threshold_deg {
             real("dihedral_threshold_deg", d, 0.0, 180.0, true)?;

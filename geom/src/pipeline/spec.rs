@@ -138,10 +138,14 @@ impl Default for GlobalOptions {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct HomologyOptions {
-    /// Basis index (0 = shortest) on the source and on the target.
-    pub basis: [usize; 2],
+    /// Basis index (0 = shortest) on the source and on the target. With neither `basis`,
+    /// `rotation` nor `matching`, the job searches for the natural class
+    /// ([`crate::homology::natural`]); with either, the other is 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub basis: Option<[usize; 2]>,
     /// τ rotates the source's 4g-gon by `rotation · 2π/g` (quarter turns for g = 1).
-    pub rotation: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rotation: Option<usize>,
     /// Where each source loop goes, e.g. `["a1 -> b1", "b1 -> -a1"]`; overrides `basis` and
     /// `rotation` with a class that induces it on H1.
     pub matching: Option<Vec<String>>,
@@ -169,8 +173,8 @@ pub struct HomologyOptions {
 impl Default for HomologyOptions {
     fn default() -> Self {
         Self {
-            basis: [0, 0],
-            rotation: 0,
+            basis: None,
+            rotation: None,
             matching: None,
             meta_mesh: false,
             dihedral_threshold_deg: None,
@@ -196,9 +200,30 @@ impl MapOptions {
     }
 }
 
+/// The homotopy class a `homology` job asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ClassChoice<'a> {
+    /// None named: the class of least distortion among those searched.
+    Natural,
+    /// Basis index on each mesh and rotation τ.
+    Explicit { basis: [usize; 2], rotation: usize },
+    /// Where each source loop goes (`a1 -> b1`, …).
+    Matching(&'a [String]),
+}
+
 impl HomologyOptions {
     pub fn relax(&self) -> RelaxOptions {
         RelaxOptions { smoothing: self.smoothing, metric_samples: self.metric_samples }
+    }
+
+    /// The class asked for: a matching first, then an explicit basis or rotation (the other at
+    /// 0), else the natural one.
+    pub fn class_choice(&self) -> ClassChoice<'_> {
+        match (&self.matching, self.basis, self.rotation) {
+            (Some(m), _, _) => ClassChoice::Matching(m),
+            (None, None, None) => ClassChoice::Natural,
+            (None, b, r) => ClassChoice::Explicit { basis: b.unwrap_or([0, 0]), rotation: r.unwrap_or(0) },
+        }
     }
 }
 

@@ -3,7 +3,8 @@
 //! is least distorted (on the same shape, the true one).
 //!
 //! Every class the method can build from the first [`NaturalClassOptions::bases`] canonical
-//! bases on each mesh and every rotation τ is composed (point location in two planar domains,
+//! bases on each mesh (up to [`NaturalClassOptions::more_bases`] when none of those is nearly
+//! isometric) and every rotation τ is composed (point location in two planar domains,
 //! cheap next to relaxing a map) and measured by the L2 stretch of its chords both ways, before
 //! any relaxation: a wrong class wraps one handle's loops around another's and stretches by
 //! factors, not percent. Classes are told apart by the induced map on H1 read in the reference
@@ -18,15 +19,20 @@ use crate::mesh::{Mesh, VertexId};
 use crate::progress::{Progress, Stage};
 
 /// Options for [`natural_classes`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NaturalClassOptions {
-    /// Canonical bases tried on each mesh (0 = shortest loops first).
+    /// Canonical bases tried on each mesh first (0 = shortest loops first).
     pub bases: usize,
+    /// Bases tried on each mesh when none of the first gives a class stretched by at most
+    /// `near`: genus 2 and more has classes the first bases and the polygon's rotations do not
+    /// reach (a turn inside one handle).
+    pub more_bases: usize,
+    pub near: f64,
 }
 
 impl Default for NaturalClassOptions {
     fn default() -> Self {
-        Self { bases: 2 }
+        Self { bases: 2, more_bases: 4, near: 1.10 }
     }
 }
 
@@ -62,53 +68,102 @@ pub fn natural_classes(
     o: &NaturalClassOptions,
     progress: &mut dyn Progress,
 ) -> Result<NaturalClassResult> {
-    let sides = |m: &Mesh, b: VertexId| -> Result<Vec<SideDomain>> {
-        let mut out = vec![side_domain(m, b, 0, None, 0, 0)?];
-        out.extend((1..o.bases.max(1)).map_while(|k| side_domain(m, b, k, None, 0, 0).ok()));
-        Ok(out)
-    };
-    let (s, t) = std::thread::scope(|sc| {
-        let h = sc.spawn(|| sides(target, bases.1));
-        (sides(source, bases.0), h.join())
-    });
-    let (s, t) = (s?, t.map_err(|_| Error::Internal("target basis thread panicked".into()))??);
-    let (fs, ft) = (Frame::new(source, &s[0].basis)?, Frame::new(target, &t[0].basis)?);
-    let g = s[0].basis.genus();
-    if g != t[0].basis.genus() {
-        return Err(
-            InputError::TopologyMismatch(format!("source genus {g}, target genus {}", t[0].basis.genus())).into()
-        );
-    }
-    let total = s.len() * t.len() * rotation_count(g);
+    let mut search = Search { source, target, bases, anchors, s: Vec::new(), t: Vec::new(), frames: None };
     let mut found: Vec<ClassCandidate> = Vec::new();
     let mut composed = 0;
-    for (ks, sk) in s.iter().enumerate() {
-        for (kt, tk) in t.iter().enumerate() {
-            let (sa, ta) = aligned(
-                (sk.clone(), tk.clone()),
-                &mut |min| side_domain(source, bases.0, ks, None, 0, min),
-                &mut |min| side_domain(target, bases.1, kt, None, 0, min),
-            )?;
-            for rotation in 0..rotation_count(g) {
-                progress.check()?;
-                progress.report(Stage::Basis, composed as f64 / total as f64);
+    for round in [0..o.bases.max(1), o.bases.max(1)..o.more_bases] {
+        if round.start > 0 && found.first().is_some_and(|c| c.stretch <= o.near) {
+            break;
+        }
+        let first = round.start;
+        search.add_bases(round)?;
+        let g = search.s[0].basis.genus();
+        let pairs: Vec<(usize, usize)> = (0..search.s.len())
+            .flat_map(|ks| (0..search.t.len()).map(move |kt| (ks, kt)))
+            .filter(|&(ks, kt)| ks.max(kt) >= first)
+            .collect();
+        for (i, &(ks, kt)) in pairs.iter().enumerate() {
+            progress.check()?;
+            progress.report(Stage::Basis, i as f64 / pairs.len() as f64);
+            for c in search.pair(ks, kt, g)? {
                 composed += 1;
-                let m = map_between(source, target, sa.clone(), ta.clone(), rotation, anchors)?;
-                let h1_reference =
-                    reference_h1((source, target), (&fs, &ft), (&m.source.basis, &m.target.basis), &m.h1)?;
-                let stretch =
-                    0.5 * (l2(source, target, &m.source_to_target)? + l2(target, source, &m.target_to_source)?);
-                let c = ClassCandidate { basis: [ks, kt], rotation, h1_reference, stretch };
                 match found.iter_mut().find(|x| x.h1_reference == c.h1_reference) {
                     Some(x) if x.stretch <= c.stretch => {}
                     Some(x) => *x = c,
                     None => found.push(c),
                 }
             }
+            found.sort_by(|a, b| a.stretch.total_cmp(&b.stretch));
         }
     }
-    found.sort_by(|a, b| a.stretch.total_cmp(&b.stretch));
     Ok(NaturalClassResult { candidates: found, composed })
+}
+
+/// The bases built so far on each mesh and the reference frames.
+struct Search<'a> {
+    source: &'a Mesh,
+    target: &'a Mesh,
+    bases: (VertexId, VertexId),
+    anchors: &'a [(VertexId, VertexId)],
+    s: Vec<SideDomain>,
+    t: Vec<SideDomain>,
+    frames: Option<(Frame, Frame)>,
+}
+
+impl Search<'_> {
+    /// Bases `ks` on each mesh (both on two threads); a basis index that cannot be built ends
+    /// that mesh's list, except basis 0, whose failure is the job's.
+    fn add_bases(&mut self, ks: std::ops::Range<usize>) -> Result<()> {
+        let more = |m: &Mesh, b: VertexId, have: usize| -> Result<Vec<SideDomain>> {
+            let mut out = Vec::new();
+            for k in ks.clone() {
+                if k != have + out.len() {
+                    break;
+                }
+                match side_domain(m, b, k, None, 0, 0) {
+                    Ok(sd) => out.push(sd),
+                    Err(e) if k == 0 => return Err(e),
+                    Err(_) => break,
+                }
+            }
+            Ok(out)
+        };
+        let (a, b) = std::thread::scope(|sc| {
+            let h = sc.spawn(|| more(self.target, self.bases.1, self.t.len()));
+            (more(self.source, self.bases.0, self.s.len()), h.join())
+        });
+        self.s.extend(a?);
+        self.t.extend(b.map_err(|_| Error::Internal("target basis thread panicked".into()))??);
+        let (g, gt) = (self.s[0].basis.genus(), self.t[0].basis.genus());
+        if g != gt {
+            return Err(InputError::TopologyMismatch(format!("source genus {g}, target genus {gt}")).into());
+        }
+        if self.frames.is_none() {
+            self.frames =
+                Some((Frame::new(self.source, &self.s[0].basis)?, Frame::new(self.target, &self.t[0].basis)?));
+        }
+        Ok(())
+    }
+
+    /// Every rotation of basis pair (`ks`, `kt`), composed and measured.
+    fn pair(&self, ks: usize, kt: usize, g: usize) -> Result<Vec<ClassCandidate>> {
+        let (source, target, bases) = (self.source, self.target, self.bases);
+        let (sa, ta) = aligned(
+            (self.s[ks].clone(), self.t[kt].clone()),
+            &mut |min| side_domain(source, bases.0, ks, None, 0, min),
+            &mut |min| side_domain(target, bases.1, kt, None, 0, min),
+        )?;
+        let (fs, ft) = self.frames.as_ref().ok_or_else(|| Error::Internal("natural: no frames".into()))?;
+        (0..rotation_count(g))
+            .map(|rotation| {
+                let m = map_between(source, target, sa.clone(), ta.clone(), rotation, self.anchors)?;
+                let h1_reference = reference_h1((source, target), (fs, ft), (&m.source.basis, &m.target.basis), &m.h1)?;
+                let stretch =
+                    0.5 * (l2(source, target, &m.source_to_target)? + l2(target, source, &m.target_to_source)?);
+                Ok(ClassCandidate { basis: [ks, kt], rotation, h1_reference, stretch })
+            })
+            .collect()
+    }
 }
 
 /// The evaluator's L2 stretch of `map`'s chords (infinite for a map that cannot be embedded).

@@ -82,10 +82,20 @@ pub fn natural_classes(
             .flat_map(|ks| (0..search.t.len()).map(move |kt| (ks, kt)))
             .filter(|&(ks, kt)| ks.max(kt) >= first)
             .collect();
-        for (i, &(ks, kt)) in pairs.iter().enumerate() {
+        // Two basis pairs at a time, one on a side thread.
+        for (i, two) in pairs.chunks(2).enumerate() {
             progress.check()?;
-            progress.report(Stage::Basis, i as f64 / pairs.len() as f64);
-            for c in search.pair(ks, kt, g)? {
+            progress.report(Stage::Basis, (2 * i) as f64 / pairs.len() as f64);
+            let search = &search;
+            let (a, b) = std::thread::scope(|sc| {
+                let h = two.get(1).map(|&(ks, kt)| sc.spawn(move || search.pair(ks, kt, g)));
+                (search.pair(two[0].0, two[0].1, g), h.map(|h| h.join()))
+            });
+            let b = match b {
+                Some(r) => r.map_err(|_| Error::Internal("natural class thread panicked".into()))??,
+                None => Vec::new(),
+            };
+            for c in a?.into_iter().chain(b) {
                 composed += 1;
                 match found.iter_mut().find(|x| x.h1_reference == c.h1_reference) {
                     Some(x) if x.stretch <= c.stretch => {}

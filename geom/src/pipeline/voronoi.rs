@@ -2,7 +2,7 @@
 //! parameterization -> composition -> global map choice -> relaxation -> metrics -> artifacts,
 //! with progress, cancellation and per-stage timings.
 
-use super::common::relax::{Direction, finish_direction, measure_direction, relax_direction};
+use super::common::relax::{Direction, finish_direction, measure_direction, relax_chords, relax_local};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
 use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
 use super::open_loops::{BoundaryReport, OpenPlan};
@@ -170,8 +170,8 @@ impl Pair<'_> {
         Ok((a?, b?))
     }
 
-    /// Relaxes a pair of maps (source → target, target → source), the target direction on a
-    /// side thread.
+    /// Relaxes a pair of contending maps (source → target, target → source) locally
+    /// ([`relax_local`]), the target direction on a side thread.
     fn relax_pair(
         &self,
         (s2t, t2s): (SurfaceMap, SurfaceMap),
@@ -180,8 +180,18 @@ impl Pair<'_> {
     ) -> Result<Relaxed> {
         let mut side = progress.silent();
         let (a, b) = both(
-            || relax_direction(self.target, self.source, t2s, self.ta, o, &mut side),
-            || relax_direction(self.source, self.target, s2t, self.sa, o, progress),
+            || relax_local(self.target, self.source, t2s, self.ta, o, &mut side),
+            || relax_local(self.source, self.target, s2t, self.sa, o, progress),
+        )?;
+        Ok((a?, b?))
+    }
+
+    /// The contest's winner, both directions, through the chord stage ([`relax_chords`]).
+    fn relax_chords(&self, (s2t, t2s): Relaxed, progress: &mut dyn Progress) -> Result<Relaxed> {
+        let mut side = progress.silent();
+        let (a, b) = both(
+            || relax_chords(self.target, self.source, t2s, self.ta, &mut side),
+            || relax_chords(self.source, self.target, s2t, self.sa, progress),
         )?;
         Ok((a?, b?))
     }
@@ -365,6 +375,7 @@ fn run_with(
                     let ((c0, c1), (o0, o1)) = (chosen, other);
                     chosen = (if keep[0] { o0 } else { c0 }, if keep[1] { o1 } else { c1 });
                 }
+                let chosen = pair.relax_chords(chosen, progress)?;
                 clock.lap("smooth");
                 pair.measure_pair(chosen, &relax, progress)?
             }

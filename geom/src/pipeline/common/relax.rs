@@ -19,12 +19,46 @@ use crate::topology::SurfacePoint;
 /// image per trial; at 58k vertices and more the sweeps alone are kept for time).
 pub const CHORD_NEWTON_MAX_VERTICES: usize = 60_000;
 
-/// One direction's relaxation: smoothing sweeps, visibility, fold repair, re-embedding and
-/// boundary sliding; `fixed` vertices (anchors, held feature vertices) stay put.
+/// One direction's relaxation: [`relax_local`], then [`relax_chords`].
 ///
 /// # Errors
 /// `Cancelled`; what the stages report.
 pub fn relax_direction(
+    from: &Mesh,
+    to: &Mesh,
+    map: SurfaceMap,
+    fixed: &[VertexId],
+    o: &RelaxOptions,
+    progress: &mut dyn Progress,
+) -> Result<(SurfaceMap, SmoothReport)> {
+    let local = relax_local(from, to, map, fixed, o, progress)?;
+    relax_chords(from, to, local, fixed, progress)
+}
+
+/// The last stage of a relaxation, on a map [`relax_local`] relaxed: the whole map at once,
+/// projected Newton on the chords the evaluator measures, every chord kept unfolded; kept when
+/// the evaluator counts no more flipped faces. Separate so that maps contending after local
+/// relaxation pay for it once, on the winner.
+///
+/// # Errors
+/// `Cancelled`; what the stage reports besides a numerical failure (which ends it).
+pub fn relax_chords(
+    from: &Mesh,
+    to: &Mesh,
+    (mut m, r): (SurfaceMap, SmoothReport),
+    fixed: &[VertexId],
+    progress: &mut dyn Progress,
+) -> Result<(SurfaceMap, SmoothReport)> {
+    let chord_steps = chord_newton(from, to, &mut m, fixed, progress)?;
+    Ok((m, SmoothReport { chord_steps, ..r }))
+}
+
+/// One direction's local relaxation: smoothing sweeps, visibility, fold repair, re-embedding and
+/// boundary sliding; `fixed` vertices (anchors, held feature vertices) stay put.
+///
+/// # Errors
+/// `Cancelled`; what the stages report.
+pub fn relax_local(
     from: &Mesh,
     to: &Mesh,
     map: SurfaceMap,
@@ -67,10 +101,7 @@ pub fn relax_direction(
             energy_after = energy;
         }
     }
-    // Last, the whole map at once: projected Newton on the chords the evaluator measures,
-    // every chord kept unfolded; kept when the evaluator counts no more flipped faces.
-    let chord_steps = chord_newton(from, to, &mut m, fixed, progress)?;
-    Ok((m, SmoothReport { repaired, made_visible: v, reembedded: untangled.regions, energy_after, chord_steps, ..r }))
+    Ok((m, SmoothReport { repaired, made_visible: v, reembedded: untangled.regions, energy_after, ..r }))
 }
 
 /// [`optimize_on_surface`] on a copy of `map`, kept when the evaluator counts no more flipped

@@ -12,7 +12,8 @@
 //! al. 2004 and Kraevoy & Sheffer 2004, section 5. Since `R`'s boundary polygon need not be
 //! convex, the current images and the Tutte embedding are both repaired in the plane
 //! ([`super::planar_untangle`]; [`super::foldover_free`] for tangles the local moves cannot
-//! free, and as a lower-distortion variant of their result), with and without the anchors'
+//! free, a bounded number of times per call, and as a lower-distortion variant of their
+//! result), with and without the anchors'
 //! rings spread as in the source, and a candidate counts only if every face of `R` keeps the
 //! chart's orientation. The candidate
 //! with the fewest evaluator-counted flips on `R` and the ring around it is kept if that is
@@ -43,11 +44,15 @@ pub struct UntangleOptions {
     pub passes: usize,
     /// Region re-embeddings tried at most (a bound on the time spent on hopeless folds).
     pub max_attempts: usize,
+    /// Runs of the global untangler ([`foldover_free`], the costliest step) from a tangle the
+    /// local moves could not free, at most, over all attempts: a sweep case (7k vertices, 42
+    /// hopeless folds) spent most of its 22 s in them for nothing (bench/NOTES.md).
+    pub max_global: usize,
 }
 
 impl Default for UntangleOptions {
     fn default() -> Self {
-        Self { max_rings: 10, chart_rings: 3, passes: 3, max_attempts: 40 }
+        Self { max_rings: 10, chart_rings: 3, passes: 3, max_attempts: 40, max_global: 32 }
     }
 }
 
@@ -193,6 +198,7 @@ fn reembed(
     is_fixed: &[bool],
     faces: &[FaceId],
     chart_rings: usize,
+    global_left: &mut usize,
 ) -> Vec<Moves> {
     let why = |m: &str| {
         if tracing::enabled!(tracing::Level::DEBUG) {
@@ -276,10 +282,17 @@ fn reembed(
                 uv.clone_from(&init);
             }
             // The global untangler (the costliest): from the tangle when the local moves fail,
-            // else from their valid result, as a lower-distortion second candidate (a valid chart
-            // embedding can still lift to a face the evaluator counts as flipped across a crease).
-            if foldover_free(&rmesh, &mut uv, &held, sign, &FoldoverFreeOptions::default()).valid {
-                sols.push(uv);
+            // while such runs are left, else from their valid result, as a lower-distortion
+            // second candidate (a valid chart embedding can still lift to a face the evaluator
+            // counts as flipped across a crease; kitten -> rocker arm needs it).
+            let from_tangle = !local;
+            if !from_tangle || *global_left > 0 {
+                if from_tangle {
+                    *global_left -= 1;
+                }
+                if foldover_free(&rmesh, &mut uv, &held, sign, &FoldoverFreeOptions::default()).valid {
+                    sols.push(uv);
+                }
             }
             if sols.is_empty() {
                 why(if spread { "no valid embedding (rings spread)" } else { "no valid embedding" });
@@ -366,6 +379,7 @@ pub fn untangle(
         faces.iter().filter(|&&f| folded(source, &tn, &index, f, pos, near)).count()
     };
     let mut attempts = 0;
+    let mut global_left = opts.max_global;
     // Seeds whose every region size failed are not tried again in later passes.
     let mut hopeless: std::collections::HashSet<FaceId> = std::collections::HashSet::new();
     for _ in 0..opts.passes {
@@ -385,7 +399,7 @@ pub fn untangle(
                 let judged = grow(source, &region, 1);
                 let before = count(&judged, &pos, &near);
                 let mut best: Option<Candidate> = None;
-                let cands = reembed(source, target, map, &is_fixed, &region, opts.chart_rings);
+                let cands = reembed(source, target, map, &is_fixed, &region, opts.chart_rings, &mut global_left);
                 let nc = cands.len();
                 let mut afters = Vec::new();
                 for moved in cands {

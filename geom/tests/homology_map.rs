@@ -52,12 +52,15 @@ fn try_run(s: &Mesh, t: &Mesh, gt: &[u32], anchors: &[u32], rotation: usize, bas
             "metrics.json",
         ],
     );
-    let mapped = common::source_on_target(&arts, s, t);
-    let gt_mean =
-        mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(gt[i]))).norm()).sum::<f64>()
-            / mapped.n_vertices() as f64
-            / t.area().sqrt();
-    Some(Run { report, gt_mean })
+    Some(Run { report, gt_mean: gt_error(&arts, s, t, gt) })
+}
+
+/// Mean distance of the mapped source vertices from their true images, over √area.
+fn gt_error(arts: &[geom::pipeline::Artifact], s: &Mesh, t: &Mesh, gt: &[u32]) -> f64 {
+    let mapped = common::source_on_target(arts, s, t);
+    mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(gt[i]))).norm()).sum::<f64>()
+        / mapped.n_vertices() as f64
+        / t.area().sqrt()
 }
 
 fn assert_clean(r: &Run, what: &str) {
@@ -234,12 +237,7 @@ fn run_natural(s: &Mesh, t: &Mesh, gt: &[u32]) -> Run {
         options: HomologyOptions { metric_samples: 5000, ..Default::default() },
     };
     let (report, arts) = run_map(&spec, s, t, &mut NoProgress).unwrap();
-    let mapped = common::source_on_target(&arts, s, t);
-    let gt_mean =
-        mapped.positions().iter().enumerate().map(|(i, p)| (p - t.position(VertexId(gt[i]))).norm()).sum::<f64>()
-            / mapped.n_vertices() as f64
-            / t.area().sqrt();
-    Run { report, gt_mean }
+    Run { report, gt_mean: gt_error(&arts, s, t, gt) }
 }
 
 /// With no class named, the job finds the true one where basis 0 and τ = 0 are not it (the

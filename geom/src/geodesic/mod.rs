@@ -9,4 +9,5 @@ mod vertex_dijkstra;
 
 pub use edge_nodes::{EdgeNodeGraph, EdgeNodeOptions, NodeId, PathOptions, SearchFilter, SurfacePath, shortest_path};
 pub use face_voronoi::{FaceVoronoiOptions, FaceVoronoiResult, face_voronoi};
+pub(crate) use heap::MinHeap;
 pub use vertex_dijkstra::{VertexDijkstraOptions, VertexDijkstraResult, vertex_dijkstra};

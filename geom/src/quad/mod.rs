@@ -7,6 +7,7 @@
 //! - [`partition`]: the genus-0 two-quad partition from four partition points.
 //! - [`patch_param`]: progressive mesh, mean-value base embedding, coarse-to-fine refinement.
 //! - [`stretch`], [`brent`], [`kernel`]: Sander's vertex optimization and its helpers.
+//! - [`sides`], [`separate`]: keeping each feature on its side of the loop on every model.
 //! - [`remesh`]: uniform resampling; [`warp`]: feature alignment; [`consistent`]: all models.
 //! - [`morph`], [`wavelet`]: spatial, multi-target and wavelet-domain morphs.
 
@@ -19,6 +20,7 @@ pub mod morph;
 pub mod partition;
 pub mod patch_param;
 pub mod remesh;
+pub mod separate;
 pub mod sides;
 pub mod stretch;
 pub mod surface;

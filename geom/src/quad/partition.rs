@@ -93,15 +93,24 @@ pub fn partition_genus0_sided(
     }
     let mut refined = Refined::identity(mesh);
     for round in 0..=opts.max_subdivisions {
-        if let Some(curves) = trace_loop(&refined.mesh, points, features)? {
-            match want {
-                None => return finish(refined, curves, points, features, round),
-                Some(w) => {
-                    if let Some(curves) = fix_sides(&refined.mesh, curves, features, w)? {
-                        return finish(refined, curves, points, features, round);
-                    }
+        let traced = trace_loop(&refined.mesh, points, features)?;
+        let found = match (traced, want) {
+            (traced, None) => traced,
+            (Some(curves), Some(w)) => match fix_sides(&refined.mesh, curves.clone(), features, w)? {
+                Some(curves) => Some(curves),
+                None => {
+                    tracing::debug!("partition: separating loop, round {round}");
+                    super::separate::separating_loop(&refined.mesh, points, features, w, Some(&curves))?
                 }
-            }
+            },
+            (None, Some(w)) => super::separate::separating_loop(&refined.mesh, points, features, w, None)?,
+        };
+        if let Some(curves) = found {
+            tracing::debug!(
+                "partition: round {round}, loop of {} vertices",
+                curves.iter().map(Vec::len).sum::<usize>()
+            );
+            return finish(refined, curves, points, features, round);
         }
         if round < opts.max_subdivisions {
             refined = refined.subdivide()?;

@@ -29,9 +29,11 @@ pub struct DecimateOptions {
     pub boundary_weight: f64,
     /// Smallest cosine between a face normal before and after a collapse.
     pub min_normal_cos: f64,
-    /// Refuse collapses that would create an interior edge between two boundary vertices (a
-    /// chord): with the boundary fixed on a convex polygon such an edge can lie along a side,
-    /// and its faces would be degenerate in the plane.
+    /// Refuse collapses that would create an edge between two held vertices (boundary or
+    /// protected) that the input does not have: with the boundary fixed on a convex polygon a
+    /// chord can lie along a side, and its faces would be degenerate in the plane; an edge
+    /// from a held feature to another held vertex leaves no free vertex between them, so
+    /// moving the feature (`quad`'s alignment) could not go around the other one.
     pub no_chords: bool,
 }
 
@@ -188,10 +190,8 @@ impl Work<'_> {
         if self.boundary[u as usize] && !(on_edge.len() == 1 && self.is_boundary_edge(u, v)) {
             return false;
         }
-        if self.no_chords
-            && self.boundary[v as usize]
-            && nu.iter().any(|&w| w != v && self.boundary[w as usize] && !on_edge.contains(&w))
-        {
+        let held = |x: u32| self.boundary[x as usize] || self.protected[x as usize];
+        if self.no_chords && held(v) && nu.iter().any(|&w| w != v && held(w) && !on_edge.contains(&w)) {
             return false;
         }
         // Link condition.

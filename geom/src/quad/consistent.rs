@@ -70,7 +70,13 @@ pub fn consistent_parameterization(
         progress.report(crate::progress::Stage::Partition, m as f64 / meshes.len() as f64);
         let points = [rows[0][m], rows[1][m], rows[2][m], rows[3][m]];
         let features: Vec<VertexId> = rows[4..].iter().map(|r| r[m]).collect();
-        let part = partition_genus0_sided(mesh, points, &features, want.as_deref(), &opts.partition)?;
+        let part =
+            partition_genus0_sided(mesh, points, &features, want.as_deref(), &opts.partition).map_err(|e| match e {
+                crate::Error::Input(InputError::LayoutConflict(msg)) => {
+                    InputError::LayoutConflict(format!("model {m}: {msg}")).into()
+                }
+                e => e,
+            })?;
         if want.is_none() {
             // Model 0 decides which patch each feature belongs to.
             let mut w = vec![0; features.len()];

@@ -92,14 +92,15 @@ pub fn partition_genus0_sided(
         }
     }
     let mut refined = Refined::identity(mesh);
+    let mut stuck = None;
     for round in 0..=opts.max_subdivisions {
         let traced = trace_loop(&refined.mesh, points, features)?;
         let found = match (traced, want) {
             (traced, None) => traced,
             (Some(curves), Some(w)) => match fix_sides(&refined.mesh, curves.clone(), features, w)? {
-                Some(curves) => Some(curves),
-                None => {
-                    tracing::debug!("partition: separating loop, round {round}");
+                Ok(curves) => Some(curves),
+                Err(k) => {
+                    stuck = Some(k);
                     super::separate::separating_loop(&refined.mesh, points, features, w, Some(&curves))?
                 }
             },
@@ -116,50 +117,56 @@ pub fn partition_genus0_sided(
             refined = refined.subdivide()?;
         }
     }
-    Err(InputError::LayoutConflict(format!(
-        "the partition points cannot be joined by disjoint paths p0->p1->p2->p3->p0{} (after {} subdivisions)",
-        if want.is_some() { " that keep every feature on its side" } else { "" },
-        opts.max_subdivisions
-    ))
+    let side = |p: usize| if p == 0 { "patch 0, left of p0->p1" } else { "patch 1, right of p0->p1" };
+    Err(InputError::LayoutConflict(match (stuck, want) {
+        (Some(k), Some(w)) => format!(
+            "feature point {k} (anchor row {}, vertex {}) must lie in {} as on the first model, but no loop \
+             through the partition points p0->p1->p2->p3->p0 keeps it there with every other feature on its \
+             side (after {} subdivisions); move that feature point or a partition point",
+            k + 4,
+            features[k].0,
+            side(w[k]),
+            opts.max_subdivisions
+        ),
+        _ => format!(
+            "the partition points cannot be joined by disjoint paths p0->p1->p2->p3->p0 that stay a vertex \
+             away from every feature point (after {} subdivisions); move a partition point",
+            opts.max_subdivisions
+        ),
+    })
     .into())
 }
 
-/// Re-traces curves until every feature lies in its wanted patch; `None` if that fails.
+/// Re-traces curves until every feature lies in its wanted patch; `Err(k)` names a feature
+/// that could not be brought to its side.
 fn fix_sides(
     mesh: &Mesh,
     mut curves: Vec<Vec<VertexId>>,
     features: &[VertexId],
     want: &[usize],
-) -> Result<Option<Vec<Vec<VertexId>>>> {
+) -> Result<std::result::Result<Vec<Vec<VertexId>>, usize>> {
+    let mut last = 0;
     for _ in 0..2 * features.len() + 1 {
         let left = super::sides::left_faces(mesh, &curves)?;
-        let wrong = features.iter().zip(want).find(|&(&f, &p)| super::sides::vertex_left(mesh, &left, f) != (p == 0));
-        if tracing::enabled!(tracing::Level::DEBUG) {
-            let n = features
-                .iter()
-                .zip(want)
-                .filter(|&(&f, &p)| super::sides::vertex_left(mesh, &left, f) != (p == 0))
-                .count();
-            tracing::debug!("features on the wrong side: {n}");
-        }
-        let Some((&f, _)) = wrong else { return Ok(Some(curves)) };
-        match super::sides::reroute(mesh, &curves, f, features)? {
+        let wrong =
+            (0..features.len()).find(|&k| super::sides::vertex_left(mesh, &left, features[k]) != (want[k] == 0));
+        let Some(k) = wrong else { return Ok(Ok(curves)) };
+        last = k;
+        match super::sides::reroute(mesh, &curves, features[k], features)? {
             Some(c) => curves = c,
             None => {
-                if tracing::enabled!(tracing::Level::DEBUG) {
-                    tracing::debug!("feature at vertex {} cannot be brought to its side", f.0);
-                }
-                return Ok(None);
+                tracing::debug!("feature {k} at vertex {} cannot be re-routed to its side", features[k].0);
+                return Ok(Err(k));
             }
         }
     }
-    Ok(None)
+    Ok(Err(last))
 }
 
 /// The four paths, or `None` when one is walled off by the ones before.
 fn trace_loop(mesh: &Mesh, points: [VertexId; 4], features: &[VertexId]) -> Result<Option<Vec<Vec<VertexId>>>> {
-    let mut blocked = vec![false; mesh.n_vertices()];
-    for v in points.iter().chain(features) {
+    let mut blocked = super::sides::feature_rings(mesh, features);
+    for v in points {
         blocked[v.idx()] = true;
     }
     let mut curves = Vec::with_capacity(4);

@@ -5,18 +5,22 @@
 //!   the loop) and `TR` (patch 1), kept a one-ring apart from each other and from the partition
 //!   points. A side without features gets one stand-in vertex, the one farthest from the rest.
 //! - A seam `γ` runs from `TL` to `TR` through face interiors (a shortest dual path).
-//! - The loop p0 -> p1 -> p2 -> p3 -> p0 is traced around both trees with exactly one net
-//!   crossing of `γ`, carried by one of its four curves; the others do not touch the seam. A
-//!   closed curve that misses both trees and crosses an arc joining them an odd number of times
-//!   separates them (Jordan), and the crossing's sign says which tree is on its left.
+//! - The loop p0 -> p1 -> p2 -> p3 -> p0 is traced around both trees and off the features'
+//!   one-rings, with exactly one net crossing of `γ`, carried by one of its four curves; the
+//!   others do not touch the seam. A closed curve that misses both trees and crosses an arc
+//!   joining them an odd number of times separates them (Jordan), and the crossing's sign says
+//!   which tree is on its left.
+//! - With a guide (the shortest loop, which puts some feature on its wrong side) the trees pay
+//!   to cross it and the loop is drawn to it, so the result departs from it only where a
+//!   feature has to change sides.
 //! - The crossing count is the layer of a two-layer lift of the vertex graph (the covering-space
 //!   construction of homotopy-constrained shortest paths, as in Erickson & Whittlesey's
 //!   "Greedy optimal homotopy and homology generators" and the `voronoi` corridors).
 //!
-//! Every (crossing curve, sign) pair is traced; the shortest loop that puts each feature on its
-//! side wins.
+//! Every (crossing curve, sign, traced first or last) choice is tried; the shortest loop that
+//! puts each feature on its side wins.
 
-use super::sides::{left_faces, vertex_left};
+use super::sides::{feature_rings, left_faces, vertex_left};
 use crate::error::Result;
 use crate::geodesic::{MinHeap, vertex_dijkstra};
 use crate::mesh::{FaceId, HalfedgeId, Mesh, VertexId};
@@ -88,7 +92,7 @@ fn attempt(
     let Some(tr) = tree(mesh, &sides[1], &blocked, &costs.tree)? else { return Ok(None) };
     let Some(seam) = seam(mesh, &tl, &tr) else { return Ok(None) };
     // The loop may not touch the trees, the features or the stand-ins.
-    let walls = or(&or(&tl, &tr), &or(&points_mask, taken));
+    let walls = or(&or(&tl, &tr), &or(&or(&points_mask, taken), &feature_rings(mesh, features)));
     let mut best: Option<(f64, Vec<Vec<VertexId>>)> = None;
     for k in 0..4 {
         for sigma in [1i8, -1] {

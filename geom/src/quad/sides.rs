@@ -17,6 +17,20 @@ use crate::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
 use crate::mesh::cut::path_edges;
 use crate::mesh::{Mesh, VertexId};
 
+/// The features and their one-rings, which the loop never enters: a feature next to the loop
+/// would have patch-boundary neighbours, which stay put while it moves to its aligned (u, v),
+/// and could leave no room for its star.
+pub fn feature_rings(mesh: &Mesh, features: &[VertexId]) -> Vec<bool> {
+    let mut m = vec![false; mesh.n_vertices()];
+    for &f in features {
+        m[f.idx()] = true;
+        for u in mesh.vertex_neighbors(f) {
+            m[u.idx()] = true;
+        }
+    }
+    m
+}
+
 /// Per face: true on the left of the loop (the side of patch 0).
 pub fn left_faces(mesh: &Mesh, curves: &[Vec<VertexId>]) -> Result<Vec<bool>> {
     let on_loop = path_edges(mesh, curves)?;
@@ -162,8 +176,8 @@ fn around(
     }
     // Re-trace c with everything else blocked.
     let mut wall = vec![false; n];
-    for f in features {
-        wall[f.idx()] = true;
+    for (w, r) in wall.iter_mut().zip(feature_rings(mesh, features)) {
+        *w |= r;
     }
     for (k, p) in curves.iter().enumerate() {
         for v in p {

@@ -228,3 +228,57 @@ fn genus_one_pair_gets_quads_from_the_voronoi_layout() {
         }
     }
 }
+
+/// The 55 cat <-> lion markers (cat vertex, lion vertex), in farthest-point order on the cat
+/// starting at marker `start`, as `bench/quad.py` and the issue's case choose them.
+fn cat_lion_markers(cat: &Mesh, start: usize) -> Vec<[u32; 2]> {
+    let text = std::fs::read_to_string(common::shared_mesh("registered/sumner_cat_lion/cat_lion_markers.txt")).unwrap();
+    let rows: Vec<[u32; 2]> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .filter_map(|l| {
+            let mut w = l.split_whitespace().map(str::parse::<u32>);
+            Some([w.next()?.ok()?, w.next()?.ok()?])
+        })
+        .collect();
+    assert_eq!(rows.len(), 55);
+    let p = |i: usize| cat.positions()[rows[i][0] as usize];
+    let mut d: Vec<f64> = (0..rows.len()).map(|i| (p(i) - p(start)).norm()).collect();
+    let mut order = vec![start];
+    while order.len() < rows.len() {
+        let i = (0..rows.len()).max_by(|&a, &b| d[a].total_cmp(&d[b])).unwrap();
+        order.push(i);
+        for (j, dj) in d.iter_mut().enumerate() {
+            *dj = dj.min((p(j) - p(i)).norm());
+        }
+    }
+    order.into_iter().map(|i| rows[i]).collect()
+}
+
+/// Issue 33's set: cat, a cat pose and the lion, four markers as partition points and eight as
+/// features. The shortest loop passes a feature on different sides on different models (with
+/// marker choices 0 and 1 every feature could not be kept on its side before the separating
+/// loop); the remeshes must share their faces, align every feature and reach 55 dB.
+#[test]
+fn cat_pose_and_lion_remesh_consistently_with_marker_features() {
+    let cat = load("registered/sumner_cat_lion/cat-reference.obj");
+    let pose = load("registered/sumner_cat_lion/cat-05.obj");
+    let lion = load("registered/sumner_cat_lion/lion-reference.obj");
+    for start in [0, 1] {
+        let rows: Vec<[u32; 3]> = cat_lion_markers(&cat, start)[..12].iter().map(|&[c, l]| [c, c, l]).collect();
+        let sp = spec(json!({"method": "quad", "anchors": rows, "options": {"level": 6, "image_level": 0}}));
+        let models = [cat.clone(), pose.clone(), lion.clone()];
+        let (rep, arts) = run_remesh(&sp, &models, &mut NoProgress).unwrap_or_else(|e| panic!("start {start}: {e}"));
+        assert_eq!(rep.feature_points, 8);
+        assert!(rep.feature_uv_error <= 1e-9, "features at identical (u, v): {}", rep.feature_uv_error);
+        let remeshes: Vec<Mesh> = (0..3).map(|i| read_obj(artifact(&arts, &format!("remesh_{i}.obj")))).collect();
+        for r in &remeshes[1..] {
+            assert_eq!(r.faces(), remeshes[0].faces(), "identical connectivity");
+        }
+        assert_closed_sphere(&remeshes[0]);
+        for (i, m) in rep.per_model.iter().enumerate() {
+            assert!(m.patches.iter().all(|p| p.flipped_uv == 0));
+            assert!(m.psnr_db >= 55.0, "start {start}, model {i}: PSNR {:.2} dB", m.psnr_db);
+        }
+    }
+}

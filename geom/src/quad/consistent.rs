@@ -131,13 +131,21 @@ pub fn consistent_parameterization(
             targets.push((k, [avg[0] / n, avg[1] / n]));
             features[k] = (p, [avg[0] / n, avg[1] / n]);
         }
-        for (model, mut base) in models.iter_mut().zip(bases) {
+        for (m, (model, mut base)) in models.iter_mut().zip(bases).enumerate() {
             let patch = &model.partition.patches[p];
             let mut moves = Vec::with_capacity(targets.len());
             for &(k, t) in &targets {
                 moves.push((local_feature(patch, k)?.0, t));
             }
-            let warp = align_features(&mut base.state, patch.corners.map(|c| c.0), &moves)?;
+            let warp = align_features(&mut base.state, patch.corners.map(|c| c.0), &moves).map_err(|e| match e {
+                crate::Error::Numerical(msg) => crate::Error::Numerical(format!(
+                    "model {m}, patch {p}: {msg} while moving the feature points of anchor rows {:?} to their common (u, v); \
+                     their positions relative to the partition loop differ too much between the models: \
+                     move a partition point or drop one of these feature points",
+                    targets.iter().map(|&(k, _)| k + 4).collect::<Vec<_>>()
+                )),
+                e => e,
+            })?;
             let frozen: Vec<VertexId> = moves.iter().map(|&(v, _)| VertexId(v)).collect();
             let r = coarse_to_fine(patch, base, &frozen, &opts.param, progress)?;
             model.patches.push(r);

@@ -2,13 +2,15 @@
 """Method `quad` measured like Yu & Chuang's Tables 1-4, on shared meshes, judged with the shared
 evaluator's sampled Hausdorff / RMS (../shared/eval/meshmetrics.py).
 
-usage: python3 bench/quad.py [path/to/surfmap] [uniform|adaptive|consistency|stretch] [filter]
+usage: python3 bench/quad.py [path/to/surfmap] [uniform|adaptive|consistency|stretch|markers] [filter]
 
 - uniform: each model alone, levels 1..8: quads, triangles, PSNR (ours and the evaluator's),
   symmetric Hausdorff in % of the bbox diagonal, time (median of 3).
 - adaptive: eps = 0.002, separately (each model alone, SA) and consistently (pairs, CA): faces, PSNR.
 - stretch: every closed shared mesh alone (4 partition points on genus 0, 24 anchors otherwise):
   L2 / L-inf stretch of the mean-value start and of the result, flips, PSNR at level 6.
+- markers: cat + cat-05 + lion with 4 + 8 of the 55 markers, each farthest-point choice (filter:
+  the start markers, e.g. 0-54): outcome, identical faces, evaluator PSNR per model.
 - consistency: pairs with ground truth (SMPL man/woman i<->i, Sumner cat poses i<->i, same-shape
   deformations): identical faces, feature (u, v) error, and the ground-truth error of the remesh
   correspondence (remesh vertex k of model 0, carried to model 1 through the known
@@ -221,12 +223,45 @@ def stretch(binary, filt):
             sys.stdout.flush()
 
 
+def markers(binary, filt):
+    """Issue 33's set: cat-reference + cat-05 + lion-reference, 12 of the 55 markers in
+    farthest-point order on the cat from marker `start` (4 partition points, 8 features), level 6.
+    filt: the starts to run ("0", "0-54"; default all)."""
+    lo, _, hi = (filt or "0-54").partition("-")
+    starts = range(int(lo), int(hi or lo) + 1)
+    root = os.path.join(M, "registered/sumner_cat_lion")
+    paths = [os.path.join(root, n) for n in ("cat-reference.obj", "cat-05.obj", "lion-reference.obj")]
+    mk = np.loadtxt(os.path.join(root, "cat_lion_markers.txt"), dtype=int, usecols=(0, 1))
+    V0, _ = mm.load_mesh(paths[0])
+    P = V0[mk[:, 0]].astype(float)
+    print("| start | outcome | identical faces | PSNR dB per model (evaluator) | time s |")
+    print("|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as tmp:
+        for start in starts:
+            order, d = [start], np.linalg.norm(P - P[start], axis=1)
+            while len(order) < 12:
+                i = int(np.argmax(d))
+                order.append(i)
+                d = np.minimum(d, np.linalg.norm(P - P[i], axis=1))
+            rows = [[int(mk[i, 0]), int(mk[i, 0]), int(mk[i, 1])] for i in order]
+            r = run(binary, tmp, paths, {"method": "quad", "anchors": rows, "options": {"level": 6, "image_level": 0}})
+            if "error" in r:
+                print(f"| {start} | {r['error']} | | | |")
+                continue
+            F = [mm.load_mesh(os.path.join(r["out"], f"remesh_{i}.obj"))[1] for i in range(3)]
+            same = all(np.array_equal(F[0], f) for f in F[1:])
+            ps = [evaluator_psnr(p, os.path.join(r["out"], f"remesh_{i}.obj"))[0] for i, p in enumerate(paths)]
+            print(f"| {start} | ok | {same} | {' / '.join(f'{x:.2f}' for x in ps)} | {r['time']:.1f} |")
+            sys.stdout.flush()
+
+
 def main():
     binary = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
         os.environ.get("CARGO_TARGET_DIR", os.path.join(HERE, "..", "target")), "release", "surfmap")
     what = sys.argv[2] if len(sys.argv) > 2 else "uniform"
     filt = sys.argv[3] if len(sys.argv) > 3 else ""
-    {"uniform": uniform, "adaptive": adaptive, "consistency": consistency, "stretch": stretch}[what](binary, filt)
+    modes = {"uniform": uniform, "adaptive": adaptive, "consistency": consistency, "stretch": stretch, "markers": markers}
+    modes[what](binary, filt)
 
 
 if __name__ == "__main__":

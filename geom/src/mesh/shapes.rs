@@ -1,7 +1,8 @@
 //! Meshes built in code, for tests and benchmarks: tetrahedron, icosphere (also with holes), torus, grid disk,
-//! and Loop-free midpoint subdivision (each triangle into four) of any mesh.
+//! Loop-free midpoint subdivision (each triangle into four) of any mesh, and the vertex farthest
+//! along a direction (tests pick landmarks with it).
 
-use super::{Mesh, P3};
+use super::{Mesh, P3, VertexId};
 use std::collections::HashMap;
 
 fn build(pos: Vec<P3>, tris: &[[u32; 3]]) -> Mesh {
@@ -165,4 +166,12 @@ pub fn try_subdivide(mesh: &Mesh, k: usize) -> crate::Result<Mesh> {
         (pos, tris) = midpoint_subdivide(&pos, &tris);
     }
     Mesh::from_triangles(pos, &tris)
+}
+
+/// The vertex farthest along `dir` (the first of ties); vertex 0 for an empty mesh.
+pub fn extreme_vertex(m: &Mesh, dir: [f64; 3]) -> VertexId {
+    let d = nalgebra::Vector3::from(dir);
+    let i = (0..m.n_vertices())
+        .max_by(|&a, &b| m.positions()[a].coords.dot(&d).total_cmp(&m.positions()[b].coords.dot(&d)));
+    VertexId::from_idx(i.unwrap_or(0))
 }

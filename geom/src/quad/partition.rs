@@ -310,12 +310,7 @@ mod tests {
     use crate::mesh::shapes;
     use crate::topology::euler_characteristic;
 
-    fn extreme(m: &Mesh, dir: [f64; 3]) -> VertexId {
-        let d = nalgebra::Vector3::from(dir);
-        let i = (0..m.n_vertices())
-            .max_by(|&a, &b| m.positions()[a].coords.dot(&d).total_cmp(&m.positions()[b].coords.dot(&d)));
-        VertexId::from_idx(i.unwrap_or(0))
-    }
+    use crate::mesh::shapes::extreme_vertex as extreme;
 
     #[test]
     fn sphere_splits_into_two_quads_with_fixed_square_boundaries() {

@@ -396,12 +396,7 @@ mod tests {
     use super::*;
     use crate::mesh::shapes;
 
-    fn extreme(m: &Mesh, dir: [f64; 3]) -> VertexId {
-        let d = nalgebra::Vector3::from(dir);
-        let i = (0..m.n_vertices())
-            .max_by(|&a, &b| m.positions()[a].coords.dot(&d).total_cmp(&m.positions()[b].coords.dot(&d)));
-        VertexId::from_idx(i.unwrap_or(0))
-    }
+    use crate::mesh::shapes::extreme_vertex as extreme;
 
     /// The curves join p0 -> p1 -> p2 -> p3 -> p0 along mesh edges, and no vertex is on two
     /// curves except the corners they share.

@@ -20,7 +20,7 @@
 //! Every (crossing curve, sign, traced first or last) choice is tried; the shortest loop that
 //! puts each feature on its side wins.
 
-use super::sides::{feature_rings, left_faces, vertex_left};
+use super::sides::{feature_rings, left_faces, vertex_left, with_one_ring as ring};
 use crate::error::Result;
 use crate::geodesic::{MinHeap, vertex_dijkstra};
 use crate::mesh::{FaceId, HalfedgeId, Mesh, VertexId};
@@ -129,17 +129,6 @@ fn unblock(m: &mut [bool], vs: &[VertexId]) {
     for v in vs {
         m[v.idx()] = false;
     }
-}
-
-/// The set and its one-ring.
-fn ring(mesh: &Mesh, m: &[bool]) -> Vec<bool> {
-    let mut out = m.to_vec();
-    for v in (0..m.len()).filter(|&v| m[v]) {
-        for u in mesh.vertex_neighbors(VertexId::from_idx(v)) {
-            out[u.idx()] = true;
-        }
-    }
-    out
 }
 
 /// The vertex farthest (along edges) from every taken one.

@@ -22,13 +22,21 @@ use crate::mesh::{Mesh, VertexId};
 /// and could leave no room for its star.
 pub fn feature_rings(mesh: &Mesh, features: &[VertexId]) -> Vec<bool> {
     let mut m = vec![false; mesh.n_vertices()];
-    for &f in features {
+    for f in features {
         m[f.idx()] = true;
-        for u in mesh.vertex_neighbors(f) {
-            m[u.idx()] = true;
+    }
+    with_one_ring(mesh, &m)
+}
+
+/// The vertices of `m` and their neighbours.
+pub fn with_one_ring(mesh: &Mesh, m: &[bool]) -> Vec<bool> {
+    let mut out = m.to_vec();
+    for v in (0..m.len()).filter(|&v| m[v]) {
+        for u in mesh.vertex_neighbors(VertexId::from_idx(v)) {
+            out[u.idx()] = true;
         }
     }
-    m
+    out
 }
 
 /// Per face: true on the left of the loop (the side of patch 0).

@@ -4,11 +4,14 @@ twist and bend, shuffled vertex order, farthest-point anchors, the true correspo
 by each method that applies, judged by the shared evaluator. Cases are drawn from a seed that is
 printed, so any run can be repeated.
 
-Usage: python3 bench/sweep.py SURFMAP_BINARY [--seed N] [--cases N] [--max-vertices V] [--check]
+Usage: python3 bench/sweep.py SURFMAP_BINARY [--seed N] [--cases N] [--max-vertices V] [--only I ...]
+                              [--check] [--require-ok]
   --cases        how many cases to draw (default 150)
   --max-vertices only meshes up to this size (default: all)
+  --only         run only these case indices of the draw (the others are drawn, not run)
   --check        exit 1 on a defect: a success with flipped faces, anchors off their partners,
                  a map off the surface, or an internal error or crash (CI runs a slice this way)
+  --require-ok   exit 1 unless every case run is ok (CI pins cases a fix made pass this way)
 Prints one row per case (case, mesh, genus, method, anchors, outcome, flips, gt, time) and a
 summary by outcome; "must" marks the classes that must not miss (genus 0 with >= 12 anchors,
 genus >= 1 with >= 24). Needs numpy + scipy.
@@ -95,8 +98,12 @@ def main():
     ap.add_argument("--seed", type=int, default=int(time.time()) % 100000)
     ap.add_argument("--cases", type=int, default=150)
     ap.add_argument("--max-vertices", type=int, default=1 << 40)
+    ap.add_argument("--only", type=int, nargs="+")
     ap.add_argument("--check", action="store_true")
+    ap.add_argument("--require-ok", action="store_true")
     a = ap.parse_args()
+    if a.only:
+        a.cases = max(a.cases, max(a.only) + 1)
     meshes = [m for m in closed_meshes() if m[1] <= a.max_vertices]
     print(f"seed {a.seed}, {a.cases} cases over {len(meshes)} closed meshes", flush=True)
     rng = np.random.default_rng(a.seed)
@@ -104,6 +111,8 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(a.cases):
             c = draw(rng, meshes)
+            if a.only and i not in a.only:
+                continue
             r = run_case(a.binary, c, tmp)
             counts[r["outcome"]] += 1
             must = must_not_miss(c)
@@ -117,6 +126,8 @@ def main():
                   f"{'must' if must else '    '} {r['outcome']:18s} {r['time']:6.2f}s  {figures}", flush=True)
     print(json.dumps({"seed": a.seed, "outcomes": counts, "must_not_miss_missed": must_miss, "defects": defects}))
     if a.check and defects:
+        sys.exit(1)
+    if a.require_ok and set(counts) - {"ok"}:
         sys.exit(1)
 
 

@@ -80,9 +80,11 @@ pub struct LayoutOptions {
     pub straighten_rounds: usize,
     /// Path flipping after the layout is built, before straightening.
     pub flip: flip::FlipOptions,
-    /// When a `voronoi` layout cannot be completed after every rebuild, build the greedy
-    /// baseline's layout instead of failing (reported in `LayoutStats::fallback`).
-    pub greedy_fallback: bool,
+    /// Use the other base domain (`voronoi` <-> `greedy`) when a `voronoi` layout cannot be
+    /// completed after every rebuild, or when the requested one's maps fold and the other's fold
+    /// less (reported in `LayoutStats::fallback`). `greedy_fallback` is its former name.
+    #[serde(alias = "greedy_fallback")]
+    pub fallback: bool,
 }
 
 impl Default for LayoutOptions {
@@ -93,7 +95,7 @@ impl Default for LayoutOptions {
             rebuilds: 3,
             straighten_rounds: 1,
             flip: Default::default(),
-            greedy_fallback: true,
+            fallback: true,
         }
     }
 }
@@ -115,7 +117,8 @@ pub struct LayoutStats {
     pub straightened: usize,
     /// Paths flipped (the same on both meshes).
     pub flipped: usize,
-    /// The path choice used instead of the requested one (`"greedy"`), if any.
+    /// The base domain used instead of the requested one (`"greedy"` or `"voronoi"`), if any:
+    /// the requested one could not be laid out, or its maps folded where these do not.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fallback: Option<String>,
 }
@@ -131,4 +134,18 @@ pub fn patches_of(t: &tracer::Tracer) -> Vec<Patch> {
             Patch { corners: [c[0], c[1], c[2]], sides: [w.halves[0], w.halves[1], w.halves[2]] }
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::LayoutOptions;
+
+    #[test]
+    fn the_fallback_option_keeps_its_former_name() {
+        for key in ["fallback", "greedy_fallback"] {
+            let o: LayoutOptions = serde_json::from_str(&format!("{{\"{key}\": false}}")).unwrap();
+            assert!(!o.fallback, "{key}");
+        }
+        assert!(LayoutOptions::default().fallback);
+    }
 }

@@ -112,7 +112,7 @@ fn build_layout<'m>(
                 return Ok(Layout { source: st, target: tt, stats: s });
             }
             Err(Error::Input(InputError::LayoutConflict(m)))
-                if attempt >= o.layout.rebuilds && used == Method::Voronoi && o.layout.greedy_fallback =>
+                if attempt >= o.layout.rebuilds && used == Method::Voronoi && o.layout.fallback =>
             {
                 tracing::debug!("greedy fallback after ({:.0} ms): {m}", clock.elapsed_ms());
                 used = Method::Greedy;
@@ -309,7 +309,28 @@ pub fn run(
     progress: &mut dyn Progress,
 ) -> Result<(LayoutMapReport, Vec<Artifact>)> {
     let go = GlobalParamOptions { enabled: spec.options.global.enabled, ..Default::default() };
-    run_with(method, spec, &go, optimize::GATE, source, target, progress)
+    let first = run_with(method, spec, &go, optimize::GATE, source, target, progress)?;
+    let folds = |r: &LayoutMapReport| r.pair.source_to_target.flipped_faces + r.pair.target_to_source.flipped_faces;
+    if folds(&first.0) == 0 || !spec.options.layout.fallback || first.0.layout.fallback.is_some() {
+        return Ok(first);
+    }
+    // The two base domains fail in different places (a limb whose patches slide past an anchor
+    // under one path choice is laid out cleanly by the other): a folded result gets the other,
+    // kept if it is fold-free.
+    let other = if method == Method::Voronoi { Method::Greedy } else { Method::Voronoi };
+    tracing::debug!("{} folds {}: trying {}", method.name(), folds(&first.0), other.name());
+    match run_with(other, spec, &go, optimize::GATE, source, target, progress) {
+        Ok(mut second) if folds(&second.0) == 0 => {
+            second.0.pair.method = method.name();
+            second.0.layout.fallback = Some(other.name().to_string());
+            let metrics = json_artifact("metrics.json", &second.0)?;
+            second.1.retain(|a| a.name != "metrics.json");
+            second.1.push(metrics);
+            Ok(second)
+        }
+        Err(Error::Cancelled) => Err(Error::Cancelled),
+        _ => Ok(first),
+    }
 }
 
 /// [`run`] with every option of the global map (tests force it) and the optimization's gate
@@ -432,7 +453,7 @@ mod tests {
         let mut options = MapOptions::default();
         options.layout.max_attempts = 1;
         options.layout.rebuilds = 0;
-        options.layout.greedy_fallback = false;
+        options.layout.fallback = false;
         let spec = LayoutSpec { boundaries: Vec::new(), anchors: crate::pipeline::AnchorRow::ids(anchors), options };
         let Err(Error::Input(e @ InputError::LayoutConflict(_))) = run(Method::Voronoi, &spec, &m, &m, &mut NoProgress)
         else {

@@ -2,6 +2,7 @@
 //! parameterization -> composition -> global map choice -> relaxation -> metrics -> artifacts,
 //! with progress, cancellation and per-stage timings.
 
+use super::common::inverse::InversePair;
 use super::common::relax::{Direction, finish_direction, measure_direction, relax_chords, relax_local};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
 use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
@@ -34,6 +35,10 @@ pub struct LayoutMapReport {
     /// The optimization in the base domain, when the composed maps were far from isometric.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimize: Option<Box<OptimizeReport>>,
+    /// The direction that folded and was replaced by the inverse of the other
+    /// (`"source_to_target"` or `"target_to_source"`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inverted: Option<&'static str>,
     /// Open meshes: how each pair of boundary loops was mapped.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub boundaries: Vec<BoundaryReport>,
@@ -376,31 +381,32 @@ fn run_with(
     // relaxation (instead of the global maps: the composed maps already are the better of
     // per-patch and global before relaxation).
     let mut optimized = optimized.map(Box::new);
-    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) =
-        match (optimized.as_mut().and_then(|r| r.maps.take()), contender) {
-            (None, None) => pair.finish(maps, &relax, &mut clock, progress)?,
-            (candidate, contender) => {
-                let mut chosen = pair.relax_pair(maps, &relax, progress)?;
-                // The per-patch composition against the global one, as a pair.
-                if let Some(g) = contender {
-                    let other = pair.relax_pair(g, &relax, progress)?;
-                    let cmp = RelaxedComparison::new(pair.qualities(&chosen)?, pair.qualities(&other)?);
-                    if global.as_mut().map_or(cmp.prefers_global(), |r| r.record_relaxed(cmp)) {
-                        chosen = other;
-                    }
+    let finished = match (optimized.as_mut().and_then(|r| r.maps.take()), contender) {
+        (None, None) => pair.finish(maps, &relax, &mut clock, progress)?,
+        (candidate, contender) => {
+            let mut chosen = pair.relax_pair(maps, &relax, progress)?;
+            // The per-patch composition against the global one, as a pair.
+            if let Some(g) = contender {
+                let other = pair.relax_pair(g, &relax, progress)?;
+                let cmp = RelaxedComparison::new(pair.qualities(&chosen)?, pair.qualities(&other)?);
+                if global.as_mut().map_or(cmp.prefers_global(), |r| r.record_relaxed(cmp)) {
+                    chosen = other;
                 }
-                // The optimized maps against the winner, per direction.
-                if let (Some(m), Some(r)) = (candidate, optimized.as_mut()) {
-                    let other = pair.relax_pair(m, &relax, progress)?;
-                    let keep = r.record_relaxed(pair.qualities(&chosen)?, pair.qualities(&other)?);
-                    let ((c0, c1), (o0, o1)) = (chosen, other);
-                    chosen = (if keep[0] { o0 } else { c0 }, if keep[1] { o1 } else { c1 });
-                }
-                let chosen = pair.relax_chords(chosen, progress)?;
-                clock.lap("smooth");
-                pair.measure_pair(chosen, &relax, progress)?
             }
-        };
+            // The optimized maps against the winner, per direction.
+            if let (Some(m), Some(r)) = (candidate, optimized.as_mut()) {
+                let other = pair.relax_pair(m, &relax, progress)?;
+                let keep = r.record_relaxed(pair.qualities(&chosen)?, pair.qualities(&other)?);
+                let ((c0, c1), (o0, o1)) = (chosen, other);
+                chosen = (if keep[0] { o0 } else { c0 }, if keep[1] { o1 } else { c1 });
+            }
+            let chosen = pair.relax_chords(chosen, progress)?;
+            clock.lap("smooth");
+            pair.measure_pair(chosen, &relax, progress)?
+        }
+    };
+    let (finished, inverted) = InversePair { source, target, pairs: &pairs }.repair(finished, &relax, progress)?;
+    let ((s2t, r1, on_target, m1), (t2s, r2, on_source, m2)) = finished;
     clock.lap("metrics");
     progress.check()?;
     let metrics = (m1, m2);
@@ -411,6 +417,7 @@ fn run_with(
         layout: stats,
         global,
         optimize: optimized,
+        inverted,
         boundaries: Vec::new(),
     };
     outputs(report, (&st, &tt, &patches, &rs, &rt), (s2t, t2s), (&on_target, &on_source), clock, progress)

@@ -1,9 +1,10 @@
 //! What every method's pipeline shares: artifacts, the stage clock, the two-halves split, the
-//! pair report every pair method writes, the last stages of each direction ([`relax`]) and
-//! the meta-mesh outputs ([`meta_mesh`]). Method files import this module and nothing else of
-//! `pipeline` but the spec.
+//! pair report every pair method writes, the last stages of each direction ([`relax`]), a folded
+//! direction replaced by the other's inverse ([`inverse`]) and the meta-mesh outputs
+//! ([`meta_mesh`]). Method files import this module and nothing else of `pipeline` but the spec.
 
 pub mod artifacts;
+pub mod inverse;
 pub mod meta_mesh;
 pub mod relax;
 

@@ -2,6 +2,7 @@
 //! -> canonical bases -> fundamental domains -> maps through the 4g-gon -> anchor snapping ->
 //! relaxation -> metrics -> artifacts (bases and domains included).
 
+use super::common::inverse::InversePair;
 use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
 use super::common::relax::{FinishedPair, finish_pair};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
@@ -108,6 +109,7 @@ pub fn run(
         }
     }
     let (chosen, r, f) = best.ok_or_else(|| Error::Internal("homology: no class to relax".into()))?;
+    let (f, inverted) = InversePair { source, target, pairs: &pairs }.repair_finished(f, &o.relax(), progress)?;
     let (basis, rotation) = plan.tries[chosen];
     // The induced map read in the reference bases (basis 0 on each mesh): the search's, or
     // computed when other bases were used or a matching was asked for.
@@ -173,7 +175,10 @@ pub fn run(
     arts.push(planar_obj("domain_source.obj", &r.source.domain.uv, &r.source.basis.disk.mesh)?);
     arts.push(planar_obj("domain_target.obj", &r.target.domain.uv, &r.target.basis.disk.mesh)?);
     clock.lap("artifacts");
-    let pair = PairReport::new("homology", pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
+    let pair = PairReport {
+        inverted,
+        ..PairReport::new("homology", pairs.len(), (source, target), (f.m1, f.m2), f.smoothing)
+    };
     let mut report = HomologyMapReport { pair: pair.with_maps(f.s2t, f.t2s), homology: report_h };
     report.pair.timings_ms = clock.finish();
     arts.push(json_artifact("metrics.json", &report)?);

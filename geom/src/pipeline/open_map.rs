@@ -45,15 +45,8 @@ pub(super) fn run(
     clock.lap("metrics");
     progress.check()?;
     let pr = PairReport::new(method.name(), pairs.len(), (source, target), (m1, m2), r1.merge(r2));
-    let report = LayoutMapReport {
-        pair: pr,
-        patches: patches.len(),
-        layout: stats,
-        global: None,
-        optimize: None,
-        inverted: None,
-        boundaries,
-    };
+    let report =
+        LayoutMapReport { pair: pr, patches: patches.len(), layout: stats, global: None, optimize: None, boundaries };
     let embedded = (&on_target, &on_source);
     outputs(report, (&st, &tt, &patches, &rs, &rt), (s2t, t2s), embedded, clock, progress)
 }

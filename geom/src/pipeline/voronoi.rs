@@ -35,10 +35,6 @@ pub struct LayoutMapReport {
     /// The optimization in the base domain, when the composed maps were far from isometric.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimize: Option<Box<OptimizeReport>>,
-    /// The direction that folded and was replaced by the inverse of the other
-    /// (`"source_to_target"` or `"target_to_source"`), if any.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub inverted: Option<&'static str>,
     /// Open meshes: how each pair of boundary loops was mapped.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub boundaries: Vec<BoundaryReport>,
@@ -410,14 +406,14 @@ fn run_with(
     clock.lap("metrics");
     progress.check()?;
     let metrics = (m1, m2);
-    let pair = PairReport::new(method.name(), pairs.len(), (source, target), metrics, r1.merge(r2));
+    let pair =
+        PairReport { inverted, ..PairReport::new(method.name(), pairs.len(), (source, target), metrics, r1.merge(r2)) };
     let report = LayoutMapReport {
         pair,
         patches: patches.len(),
         layout: stats,
         global,
         optimize: optimized,
-        inverted,
         boundaries: Vec::new(),
     };
     outputs(report, (&st, &tt, &patches, &rs, &rt), (s2t, t2s), (&on_target, &on_source), clock, progress)

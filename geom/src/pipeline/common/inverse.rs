@@ -8,8 +8,9 @@
 //! pipelines are computed apart and fold in different places (a limb that slides past an
 //! anchor one way is mapped cleanly the other way).
 
-use super::relax::{Direction, finish_direction};
+use super::relax::{Direction, FinishedPair, finish_direction};
 use crate::crossparam::compose::place_anchors;
+use crate::crossparam::smooth::SmoothReport;
 use crate::error::Result;
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
@@ -53,6 +54,25 @@ impl InversePair<'_> {
             return Ok(((s2t, d), Some("target_to_source")));
         }
         Ok(((s2t, t2s), None))
+    }
+
+    /// [`InversePair::repair`] on a one-patch method's finished pair (its relaxation report
+    /// stays that of the maps it started from).
+    ///
+    /// # Errors
+    /// As [`InversePair::repair`].
+    pub fn repair_finished(
+        &self,
+        f: FinishedPair,
+        o: &RelaxOptions,
+        progress: &mut dyn Progress,
+    ) -> Result<(FinishedPair, Option<&'static str>)> {
+        let smoothing = f.smoothing;
+        let d1 = (f.s2t, SmoothReport::default(), f.on_target, f.m1);
+        let d2 = (f.t2s, SmoothReport::default(), f.on_source, f.m2);
+        let ((a, b), inverted) = self.repair((d1, d2), o, progress)?;
+        let f = FinishedPair { s2t: a.0, t2s: b.0, on_target: a.2, on_source: b.2, m1: a.3, m2: b.3, smoothing };
+        Ok((f, inverted))
     }
 
     /// The relaxed inverse of `d` (a direction `from -> to`) as a direction `to -> from`, if the

@@ -82,6 +82,10 @@ pub struct PairReport {
     /// meta-mesh pair was built instead; otherwise a folded map fails the job).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub withheld: Vec<String>,
+    /// The direction that folded and was replaced by the inverse of the other
+    /// (`"source_to_target"` or `"target_to_source"`, see [`inverse`]), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inverted: Option<&'static str>,
     /// The maps themselves (not in `metrics.json`), for the outputs `run_job` builds in the
     /// inputs' own layouts.
     #[serde(skip)]
@@ -117,6 +121,7 @@ impl PairReport {
             timings_ms: Vec::new(),
             smoothing,
             withheld: Vec::new(),
+            inverted: None,
             maps: None,
             anchor_points: Vec::new(),
         }

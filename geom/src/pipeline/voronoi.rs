@@ -317,11 +317,11 @@ pub fn run(
     }
     // The two base domains fail in different places (a limb whose patches slide past an anchor
     // under one path choice is laid out cleanly by the other): a folded result gets the other,
-    // kept if it is fold-free.
+    // kept if it is fold-free and every image lies on the surface as the evaluator reads it.
     let other = if method == Method::Voronoi { Method::Greedy } else { Method::Voronoi };
     tracing::debug!("{} folds {}: trying {}", method.name(), folds(&first.0), other.name());
     match run_with(other, spec, &go, optimize::GATE, source, target, progress) {
-        Ok(mut second) if folds(&second.0) == 0 => {
+        Ok(mut second) if folds(&second.0) == 0 && on_surface(&second.0, source, target) => {
             second.0.pair.method = method.name();
             second.0.layout.fallback = Some(other.name().to_string());
             let metrics = json_artifact("metrics.json", &second.0)?;
@@ -332,6 +332,13 @@ pub fn run(
         Err(Error::Cancelled) => Err(Error::Cancelled),
         _ => Ok(first),
     }
+}
+
+/// Whether every image of both directions lies on the surface as the evaluator reads it (to
+/// rounding, relative to the bounding-box diagonal).
+fn on_surface(r: &LayoutMapReport, source: &Mesh, target: &Mesh) -> bool {
+    let tol = |m: &Mesh| 1e-9 * m.bbox_diagonal();
+    r.pair.source_to_target.off_surface_max <= tol(target) && r.pair.target_to_source.off_surface_max <= tol(source)
 }
 
 /// [`run`] with every option of the global map (tests force it) and the optimization's gate

@@ -1,7 +1,8 @@
 //! No folded map is returned as a success. After a job's pipeline has run, a pair map with
 //! flipped faces in either direction (the evaluator's count), or a `quad` parameterization with
 //! flipped triangles, turns into [`Error::MapFolds`], which says how many, where (face ids and
-//! the anchor nearest to each) and what to try. The one exception: a `homology` job that built
+//! the anchor nearest to each) and what to try; a fold-free one with an image off the surface
+//! fails as `Numerical`. The one exception: a `homology` job that built
 //! its meta-mesh pair, which is fold-free by construction, succeeds with the folded direction's
 //! vertex-map artifacts withheld (listed in the report's `withheld`).
 
@@ -56,7 +57,7 @@ pub(super) fn refuse_folds(
     let Some(pair) = report.pair_mut() else { return Ok(()) };
     let counts = [pair.source_to_target.flipped_faces, pair.target_to_source.flipped_faces];
     if counts == [0, 0] {
-        return Ok(());
+        return refuse_off_surface(pair, meshes);
     }
     if meta_built {
         for (d, names) in VERTEX_MAPS.iter().enumerate() {
@@ -89,6 +90,31 @@ pub(super) fn refuse_folds(
         .collect::<Vec<_>>()
         .join("; ");
     Err(Error::MapFolds { flipped: counts[0] + counts[1], detail: format!("{where_}. {}", remedies(spec)) })
+}
+
+/// Largest distance of an image from the surface, as the evaluator reads it, relative to the
+/// bounding-box diagonal of the mesh it lies on, that a success may have (a visible image is
+/// exact to rounding; a hidden one is off by 1e-5 and more).
+const OFF_SURFACE: f64 = 1e-6;
+
+/// A fold-free pair map with an image off the surface is as wrong as a folded one: `Numerical`.
+fn refuse_off_surface(pair: &super::common::PairReport, meshes: &[Mesh]) -> Result<()> {
+    let [s, t] = meshes else { return Ok(()) };
+    let bad: Vec<String> = [
+        (pair.source_to_target.off_surface_max, t, "source -> target"),
+        (pair.target_to_source.off_surface_max, s, "target -> source"),
+    ]
+    .iter()
+    .filter(|(d, m, _)| *d > OFF_SURFACE * m.bbox_diagonal())
+    .map(|(d, _, name)| format!("{name}: {d:.3e}"))
+    .collect();
+    if bad.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Numerical(format!(
+        "the map places images off the surface ({}); add anchors near them or try the other method",
+        bad.join(", ")
+    )))
 }
 
 fn spec_anchors(spec: &JobSpec) -> Vec<[u64; 2]> {
@@ -159,6 +185,13 @@ mod tests {
         let (mut report, mut arts) = run_job(&spec, &meshes, &mut NoProgress).unwrap();
         assert!(refuse_folds(&spec, &meshes, &mut report, &mut arts).is_ok());
         let JobReport::Layout(r) = &mut report else { panic!("a layout report") };
+        // Fold-free with an image off the surface: a typed failure too.
+        r.pair.source_to_target.off_surface_max = 0.01;
+        let e = refuse_folds(&spec, &meshes, &mut report, &mut arts).unwrap_err();
+        assert_eq!(e.code(), "numerical");
+        assert!(e.to_string().contains("off the surface (source -> target: 1.000e-2)"), "{e}");
+        let JobReport::Layout(r) = &mut report else { panic!("a layout report") };
+        r.pair.source_to_target.off_surface_max = 0.0;
         r.pair.target_to_source.flipped_faces = 2;
         r.pair.target_to_source.flipped_face_ids = vec![7, 11];
         let e = refuse_folds(&spec, &meshes, &mut report, &mut arts).unwrap_err();

@@ -6,7 +6,7 @@
 //! its meta-mesh pair, which is fold-free by construction, succeeds with the folded direction's
 //! vertex-map artifacts withheld (listed in the report's `withheld`).
 
-use super::common::{Artifact, json_artifact};
+use super::common::{Artifact, on_surface, rewrite_metrics};
 use super::{JobReport, JobSpec};
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, VertexId};
@@ -66,10 +66,7 @@ pub(super) fn refuse_folds(
                 pair.withheld.extend(names.iter().map(|n| n.to_string()));
             }
         }
-        let metrics = json_artifact("metrics.json", report)?;
-        arts.retain(|a| a.name != "metrics.json");
-        arts.push(metrics);
-        return Ok(());
+        return rewrite_metrics(arts, report);
     }
     let [s, t] = meshes else { return Ok(()) };
     let anchors = spec_anchors(spec);
@@ -100,14 +97,12 @@ const OFF_SURFACE: f64 = 1e-6;
 /// A fold-free pair map with an image off the surface is as wrong as a folded one: `Numerical`.
 fn refuse_off_surface(pair: &super::common::PairReport, meshes: &[Mesh]) -> Result<()> {
     let [s, t] = meshes else { return Ok(()) };
-    let bad: Vec<String> = [
-        (pair.source_to_target.off_surface_max, t, "source -> target"),
-        (pair.target_to_source.off_surface_max, s, "target -> source"),
-    ]
-    .iter()
-    .filter(|(d, m, _)| *d > OFF_SURFACE * m.bbox_diagonal())
-    .map(|(d, _, name)| format!("{name}: {d:.3e}"))
-    .collect();
+    let bad: Vec<String> =
+        [(&pair.source_to_target, t, "source -> target"), (&pair.target_to_source, s, "target -> source")]
+            .iter()
+            .filter(|(m, onto, _)| !on_surface(m, onto, OFF_SURFACE))
+            .map(|(m, _, name)| format!("{name}: {:.3e}", m.off_surface_max))
+            .collect();
     if bad.is_empty() {
         return Ok(());
     }

@@ -134,8 +134,7 @@ pub fn run_with_layouts(
     };
     if let (Some(r), Some(pair)) = (&resolved, report.pair_mut()) {
         pair.anchor_points = r.snaps.clone();
-        arts.retain(|a| a.name != "metrics.json");
-        arts.push(common::json_artifact("metrics.json", &report)?);
+        common::rewrite_metrics(&mut arts, &report)?;
     }
     folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
     let inverse = match spec {

@@ -4,7 +4,9 @@
 
 use super::common::inverse::InversePair;
 use super::common::relax::{Direction, finish_direction, measure_direction, relax_chords, relax_local};
-use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
+use super::common::{
+    Artifact, Clock, PairReport, VISIBLE, artifacts, both, json_artifact, on_surface, rewrite_metrics,
+};
 use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
 use super::open_loops::{BoundaryReport, OpenPlan};
 use super::optimize::{self, OptimizeReport, Quality};
@@ -321,24 +323,19 @@ pub fn run(
     let other = if method == Method::Voronoi { Method::Greedy } else { Method::Voronoi };
     tracing::debug!("{} folds {}: trying {}", method.name(), folds(&first.0), other.name());
     match run_with(other, spec, &go, optimize::GATE, source, target, progress) {
-        Ok(mut second) if folds(&second.0) == 0 && on_surface(&second.0, source, target) => {
+        Ok(mut second)
+            if folds(&second.0) == 0
+                && on_surface(&second.0.pair.source_to_target, target, VISIBLE)
+                && on_surface(&second.0.pair.target_to_source, source, VISIBLE) =>
+        {
             second.0.pair.method = method.name();
             second.0.layout.fallback = Some(other.name().to_string());
-            let metrics = json_artifact("metrics.json", &second.0)?;
-            second.1.retain(|a| a.name != "metrics.json");
-            second.1.push(metrics);
+            rewrite_metrics(&mut second.1, &second.0)?;
             Ok(second)
         }
         Err(Error::Cancelled) => Err(Error::Cancelled),
         _ => Ok(first),
     }
-}
-
-/// Whether every image of both directions lies on the surface as the evaluator reads it (to
-/// rounding, relative to the bounding-box diagonal).
-fn on_surface(r: &LayoutMapReport, source: &Mesh, target: &Mesh) -> bool {
-    let tol = |m: &Mesh| 1e-9 * m.bbox_diagonal();
-    r.pair.source_to_target.off_surface_max <= tol(target) && r.pair.target_to_source.off_surface_max <= tol(source)
 }
 
 /// [`run`] with every option of the global map (tests force it) and the optimization's gate

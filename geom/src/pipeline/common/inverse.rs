@@ -9,6 +9,7 @@
 //! anchor one way is mapped cleanly the other way).
 
 use super::relax::{Direction, FinishedPair, finish_direction};
+use super::{VISIBLE, on_surface};
 use crate::crossparam::compose::place_anchors;
 use crate::crossparam::smooth::SmoothReport;
 use crate::error::Result;
@@ -16,10 +17,6 @@ use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
 use crate::pipeline::spec::RelaxOptions;
 use crate::progress::Progress;
-
-/// Largest distance of an image from the surface, relative to the bounding-box diagonal, for an
-/// inverse to stand (the evaluator's reading of a visible image is exact to rounding).
-const OFF_SURFACE: f64 = 1e-9;
 
 /// The two meshes of a pair with their anchors, one row per anchor (source, target).
 pub struct InversePair<'a> {
@@ -96,7 +93,7 @@ impl InversePair<'_> {
         tracing::debug!(flipped = m.flipped_faces, off = m.off_surface_max, "inverse of the fold-free direction");
         // Every image must also lie on the surface as the evaluator finds it (a hidden image,
         // one the evaluator's nearest faces miss, is as wrong as a fold).
-        Ok((m.flipped_faces == 0 && m.off_surface_max <= OFF_SURFACE * from.bbox_diagonal()).then_some(out))
+        Ok((m.flipped_faces == 0 && on_surface(m, from, VISIBLE)).then_some(out))
     }
 }
 

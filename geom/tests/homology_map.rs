@@ -100,6 +100,19 @@ fn kitten_bent_genus_one() {
     let gt: Vec<u32> = (0..s.n_vertices() as u32).collect();
     let r = run(&s, &t, &gt, &[0], 0, [0, 0]);
     assert_clean(&r, "kitten bent");
+    assert!(r.report.homology.flat_torus, "genus 1 maps through the flat tori");
+}
+
+/// A twisted, shuffled kitten with the class left to the job: it maps through the flat tori
+/// (`homology::flat`) onto the true class, fold-free and close to the true map.
+#[test]
+fn twisted_kitten_natural_class_through_the_flat_tori() {
+    let s = load("kitten.nf20k.off");
+    let (t, gt) = shuffled(&common::twisted_as_in_the_bench(&s));
+    let r = run_natural(&s, &t, &gt);
+    assert_clean(&r, "kitten twisted");
+    assert!(r.report.homology.flat_torus, "genus 1 maps through the flat tori");
+    assert_eq!(r.report.homology.h1_reference.as_ref(), Some(&vec![vec![1, 0], vec![0, 1]]), "the true class");
 }
 
 #[test]

@@ -7,6 +7,7 @@
 use super::basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis};
 use super::compose::{Planar, locate_all, warp_interior};
 use super::domain::{FundamentalDomainResult, fundamental_domain};
+use super::flat::{FlatTorusResult, flat_torus, locate_all_periodic};
 use crate::error::{InputError, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
@@ -25,6 +26,8 @@ pub struct HomologyMapOptions {
     pub max_subdivisions: Option<usize>,
     /// Stretch-minimizing reweighting rounds of each domain map.
     pub stretch_iterations: usize,
+    /// Genus 1: compose through the 4g-gons even where both flat tori exist.
+    pub square: bool,
 }
 
 /// One side's basis and domain.
@@ -32,12 +35,20 @@ pub struct HomologyMapOptions {
 pub struct SideDomain {
     pub basis: CanonicalBasisResult,
     pub domain: FundamentalDomainResult,
+    /// Genus 1: the flat torus, when its embedding is bijective.
+    pub flat: Option<FlatTorusResult>,
 }
 
 impl SideDomain {
     /// The disk and its planar positions, for composing maps.
     pub fn planar(&self) -> Planar<'_> {
         Planar { disk: &self.basis.disk, uv: &self.domain.uv, refined: Some(&self.basis.refined) }
+    }
+
+    /// The disk on its flat torus, when it has one.
+    pub fn flat_planar(&self) -> Option<Planar<'_>> {
+        let f = self.flat.as_ref()?;
+        Some(Planar { disk: &self.basis.disk, uv: &f.uv, refined: Some(&self.basis.refined) })
     }
 }
 
@@ -53,6 +64,8 @@ pub struct HomologyMapResult {
     pub side_shift: usize,
     /// Whether the source domain was warped to put the anchors on their partners.
     pub warped: bool,
+    /// Genus 1: whether the maps went through the flat tori (else the squares).
+    pub flat: bool,
     pub source: SideDomain,
     pub target: SideDomain,
 }
@@ -80,7 +93,14 @@ pub fn side_domain(
     }
     let basis = canonical_basis(mesh, base, &o)?;
     let domain = fundamental_domain(&basis, stretch_iterations)?;
-    Ok(SideDomain { basis, domain })
+    // Genus 1: maps go through the flat torus; the square stays for the meta-mesh overlay, and
+    // takes over should the flat embedding not be bijective.
+    let flat = if basis.genus() == 1 {
+        Some(flat_torus(&basis, &domain.uv)?).filter(|f| f.injectivity.is_injective())
+    } else {
+        None
+    };
+    Ok(SideDomain { basis, domain, flat })
 }
 
 /// Maps `source` and `target` through canonical bases at `bases = (source vertex, target vertex)`.
@@ -104,7 +124,7 @@ pub fn homology_map(
     });
     let (s, t) = (s?, t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??);
     let (s, t) = aligned((s, t), &mut |min| side(source, bases.0, 0, min), &mut |min| side(target, bases.1, 1, min))?;
-    map_between(source, target, s, t, opts.rotation, anchors)
+    map_between(source, target, s, t, opts.rotation, anchors, opts.square)
 }
 
 /// Both meshes refined alike: the side found at an earlier attempt is searched again up to the
@@ -143,6 +163,7 @@ pub fn map_between(
     t: SideDomain,
     rotation: usize,
     anchors: &[(VertexId, VertexId)],
+    square: bool,
 ) -> Result<HomologyMapResult> {
     let g = s.basis.genus();
     if g != t.basis.genus() {
@@ -151,16 +172,88 @@ pub fn map_between(
     let m = 4 * g;
     let shift = if g == 1 { rotation % 4 } else { 4 * (rotation % g) };
     let angle = std::f64::consts::TAU * shift as f64 / m as f64;
-    let rot = |p: Uv, a: f64| [p[0] * a.cos() - p[1] * a.sin(), p[0] * a.sin() + p[1] * a.cos()];
+    // Genus 1: through the flat tori unless asked otherwise or one is not bijective.
+    let flat = if square { None } else { through_flat(source, target, &mut s, &t, angle, anchors)? };
+    let (composed, flat) = match flat {
+        Some(f) => (f, true),
+        None => (through_square(source, target, &mut s, &t, angle, anchors)?, false),
+    };
+    let Composed { source_to_target, target_to_source, warped } = composed;
+    let h1 = induced_h1(&s.basis, &t.basis, shift);
+    Ok(HomologyMapResult {
+        source_to_target,
+        target_to_source,
+        h1,
+        side_shift: shift,
+        warped,
+        flat,
+        source: s,
+        target: t,
+    })
+}
+
+/// Both directions of one composition, and whether the anchor warp was kept.
+struct Composed {
+    source_to_target: SurfaceMap,
+    target_to_source: SurfaceMap,
+    warped: bool,
+}
+
+fn rotated(p: Uv, a: f64) -> Uv {
+    [p[0] * a.cos() - p[1] * a.sin(), p[0] * a.sin() + p[1] * a.cos()]
+}
+
+/// Through the two 4g-gons, the source's turned by `angle` (its interior warped onto the anchors
+/// when that stays bijective).
+fn through_square(
+    source: &Mesh,
+    target: &Mesh,
+    s: &mut SideDomain,
+    t: &SideDomain,
+    angle: f64,
+    anchors: &[(VertexId, VertexId)],
+) -> Result<Composed> {
     let warped =
-        warp_interior(&s.basis.disk, &mut s.domain.uv, &s.basis.walk, &t.planar(), anchors, &|p| rot(p, -angle))?;
+        warp_interior(&s.basis.disk, &mut s.domain.uv, &s.basis.walk, &t.planar(), anchors, &|p| rotated(p, -angle))?;
     if warped {
         s.domain.injectivity = super::domain::exact_orientation(&s.basis.disk.mesh, &s.domain.uv);
     }
-    let source_to_target = locate_all(source.n_vertices(), &s.planar(), &t.planar(), &|p| rot(p, angle));
-    let target_to_source = locate_all(target.n_vertices(), &t.planar(), &s.planar(), &|p| rot(p, -angle));
-    let h1 = induced_h1(&s.basis, &t.basis, shift);
-    Ok(HomologyMapResult { source_to_target, target_to_source, h1, side_shift: shift, warped, source: s, target: t })
+    Ok(Composed {
+        source_to_target: locate_all(source.n_vertices(), &s.planar(), &t.planar(), &|p| rotated(p, angle)),
+        target_to_source: locate_all(target.n_vertices(), &t.planar(), &s.planar(), &|p| rotated(p, -angle)),
+        warped,
+    })
+}
+
+/// Through the two flat tori (genus 1, both bijective), the source's turned by `angle`.
+fn through_flat(
+    source: &Mesh,
+    target: &Mesh,
+    s: &mut SideDomain,
+    t: &SideDomain,
+    angle: f64,
+    anchors: &[(VertexId, VertexId)],
+) -> Result<Option<Composed>> {
+    let (Some(sf), Some(tp)) = (s.flat.as_mut(), t.flat_planar()) else {
+        return Ok(None);
+    };
+    let warped = warp_interior(&s.basis.disk, &mut sf.uv, &s.basis.walk, &tp, anchors, &|p| rotated(p, -angle))?;
+    let period = sf.period;
+    let sp = Planar { disk: &s.basis.disk, uv: &sf.uv, refined: Some(&s.basis.refined) };
+    Ok(Some(Composed {
+        source_to_target: locate_all_periodic(source.n_vertices(), &sp, &tp, period, &|p| rotated(p, angle)),
+        target_to_source: locate_all_periodic(target.n_vertices(), &tp, &sp, period, &|p| rotated(p, -angle)),
+        warped,
+    }))
+}
+
+/// The evaluator's L2 stretch of `map`'s chords (infinite for a map that cannot be embedded).
+///
+/// # Errors
+/// When `map` does not fit the meshes.
+pub fn chord_l2(from: &Mesh, to: &Mesh, map: &SurfaceMap) -> Result<f64> {
+    let s = crate::metrics::distortion(from, &map.embed(from, to)?).l2_stretch;
+    Ok(if s.is_finite() { s } else { f64::INFINITY })
 }
 
 /// The induced map on H1 when the source domain is turned by `rotation` steps.

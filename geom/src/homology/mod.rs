@@ -11,6 +11,7 @@
 //! - [`basis`]: the canonical basis itself.
 //! - [`classes`]: integer classes of basis loops; H1 in reference bases.
 //! - [`domain`]: the cut disk on the regular 4g-gon.
+//! - [`flat`]: a genus-1 mesh on its flat torus (periodic Tutte embedding).
 //! - [`map`]: maps both ways through the two domains, rotation τ, induced map on H1.
 //! - [`matching`]: an explicit curve matching (`a1 -> b1`, …) realized by basis and rotation.
 //! - [`natural`]: the classes reachable by bases and rotations, least stretched first.
@@ -35,6 +36,7 @@ pub mod feature_handles;
 pub mod feature_map;
 pub mod feature_overlay;
 pub mod features;
+pub mod flat;
 pub mod map;
 pub mod matching;
 pub mod natural;

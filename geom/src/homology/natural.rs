@@ -11,10 +11,9 @@
 //! bases ([`super::classes`]); the least stretched realization of each class stands for it.
 //! The pipeline relaxes candidates in this order and keeps the best relaxed one.
 
-use super::map::{SideDomain, aligned, map_between, rotation_count, side_domain};
+use super::map::{SideDomain, aligned, chord_l2, map_between, rotation_count, side_domain};
 use super::matching::{Frame, reference_h1};
 use crate::error::{Error, InputError, Result};
-use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
 use crate::progress::{Progress, Stage};
 
@@ -166,18 +165,12 @@ impl Search<'_> {
         let (fs, ft) = self.frames.as_ref().ok_or_else(|| Error::Internal("natural: no frames".into()))?;
         (0..rotation_count(g))
             .map(|rotation| {
-                let m = map_between(source, target, sa.clone(), ta.clone(), rotation, self.anchors)?;
+                let m = map_between(source, target, sa.clone(), ta.clone(), rotation, self.anchors, false)?;
                 let h1_reference = reference_h1((source, target), (fs, ft), (&m.source.basis, &m.target.basis), &m.h1)?;
-                let stretch =
-                    0.5 * (l2(source, target, &m.source_to_target)? + l2(target, source, &m.target_to_source)?);
+                let stretch = 0.5
+                    * (chord_l2(source, target, &m.source_to_target)? + chord_l2(target, source, &m.target_to_source)?);
                 Ok(ClassCandidate { basis: [ks, kt], rotation, h1_reference, stretch })
             })
             .collect()
     }
-}
-
-/// The evaluator's L2 stretch of `map`'s chords (infinite for a map that cannot be embedded).
-fn l2(from: &Mesh, to: &Mesh, map: &SurfaceMap) -> Result<f64> {
-    let s = crate::metrics::distortion(from, &map.embed(from, to)?).l2_stretch;
-    Ok(if s.is_finite() { s } else { f64::INFINITY })
 }

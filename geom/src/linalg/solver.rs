@@ -307,9 +307,27 @@ impl FixedBoundaryFactor<'_> {
         &self,
         fixed_values: &dyn Fn(VertexId) -> [f64; K],
     ) -> Result<(Vec<[f64; K]>, f64)> {
+        self.solve_loaded(fixed_values, &|_| [0.0; K])
+    }
+
+    /// [`FixedBoundaryFactor::solve_with_residual`] with a load on every free vertex's equation:
+    /// `Σ_j w_ij (x_i − x_j) = load(i)` (a periodic embedding's jumps across its cut, say).
+    ///
+    /// # Errors
+    /// As [`FixedBoundaryFactor::solve`].
+    pub fn solve_loaded<const K: usize>(
+        &self,
+        fixed_values: &dyn Fn(VertexId) -> [f64; K],
+        load: &dyn Fn(VertexId) -> [f64; K],
+    ) -> Result<(Vec<[f64; K]>, f64)> {
         let sys = self.sys;
         let n = sys.free.len();
         let mut rhs = Mat::<f64>::zeros(n, K);
+        for (i, &v) in sys.free.iter().enumerate() {
+            for (k, x) in load(v).iter().enumerate() {
+                rhs[(i, k)] = *x;
+            }
+        }
         for &(row, v, w) in &self.coupling {
             let val = fixed_values(VertexId(v));
             for (k, x) in val.iter().enumerate() {

@@ -8,11 +8,12 @@ use super::common::relax::{FinishedPair, finish_pair};
 use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
 use super::homology_class::{CandidateReport, ClassPlan, Relaxed, candidate_reports};
 use super::spec::HomologySpec;
+use super::spec::RelaxOptions;
 use crate::error::{Error, Result};
 use crate::homology::map::SideDomain;
 use crate::homology::matching::{reference_frame, reference_h1};
 use crate::homology::{HomologyMapOptions, HomologyMapResult, homology_map};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, VertexId};
 use crate::progress::{Progress, Stage};
 use serde::Serialize;
 use serde_json::json;
@@ -35,6 +36,9 @@ pub struct HomologyReport {
     pub side_shift: usize,
     /// Whether the source domain was warped onto the anchors (constrained mean-value map).
     pub anchor_warp: bool,
+    /// Genus 1: whether the maps went through the two flat tori (`homology::flat`), the less
+    /// stretched composition; else through the 4g-gons.
+    pub flat_torus: bool,
     /// Induced map on H1 (`a1, b1, …`), column `j` the image of source loop `j`.
     pub h1: Vec<Vec<i32>>,
     /// The same map read in the reference bases (basis 0 on each mesh), when other bases were
@@ -79,25 +83,7 @@ pub fn run(
     let mut relaxed: Vec<Relaxed> = Vec::new();
     let mut best: Option<(usize, HomologyMapResult, FinishedPair)> = None;
     for (i, &(basis, rotation)) in plan.tries.iter().enumerate() {
-        let hopts = HomologyMapOptions {
-            basis,
-            rotation,
-            max_subdivisions: None,
-            // Reweighting each domain on its own lowers each map's stretch but raised the
-            // composed map's folds on every different-shape pair measured (bench/NOTES.md).
-            stretch_iterations: 0,
-        };
-        let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
-        progress.check()?;
-        let f = finish_pair(
-            source,
-            target,
-            (&r.source_to_target, &r.target_to_source),
-            &pairs,
-            (&[], &[]),
-            &o.relax(),
-            progress,
-        )?;
+        let (r, f) = relax_class(source, target, &pairs, basis, rotation, &o.relax(), progress)?;
         let out =
             Relaxed { flips: [f.m1.flipped_faces, f.m2.flipped_faces], l2_stretch: [f.m1.l2_stretch, f.m2.l2_stretch] };
         relaxed.push(out);
@@ -159,6 +145,7 @@ pub fn run(
         rotation,
         side_shift: r.side_shift,
         anchor_warp: r.warped,
+        flat_torus: r.flat,
         h1: r.h1.clone(),
         h1_reference,
         candidates,
@@ -184,6 +171,56 @@ pub fn run(
     arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);
     Ok((report, arts))
+}
+
+/// One class built and relaxed. A genus-1 class goes through the flat tori first; if that map
+/// folds after relaxation, the square domains' map is relaxed too and the better stands
+/// (between different shapes the flat tori can differ more than the squares' interiors do).
+fn relax_class(
+    source: &Mesh,
+    target: &Mesh,
+    pairs: &[(VertexId, VertexId)],
+    basis: [usize; 2],
+    rotation: usize,
+    relax: &RelaxOptions,
+    progress: &mut dyn Progress,
+) -> Result<(HomologyMapResult, FinishedPair)> {
+    let mut best: Option<(HomologyMapResult, FinishedPair)> = None;
+    for square in [false, true] {
+        let hopts = HomologyMapOptions {
+            basis,
+            rotation,
+            max_subdivisions: None,
+            // Reweighting each domain on its own lowers each map's stretch but raised the
+            // composed map's folds on every different-shape pair measured (bench/NOTES.md).
+            stretch_iterations: 0,
+            square,
+        };
+        let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
+        progress.check()?;
+        let f = finish_pair(
+            source,
+            target,
+            (&r.source_to_target, &r.target_to_source),
+            pairs,
+            (&[], &[]),
+            relax,
+            progress,
+        )?;
+        let key = |f: &FinishedPair| Relaxed {
+            flips: [f.m1.flipped_faces, f.m2.flipped_faces],
+            l2_stretch: [f.m1.l2_stretch, f.m2.l2_stretch],
+        };
+        let flat = r.flat;
+        if best.as_ref().is_none_or(|(_, b)| key(&f).better_than(&key(b))) {
+            best = Some((r, f));
+        }
+        let folds = best.as_ref().is_some_and(|(_, b)| key(b).flips != [0, 0]);
+        if !flat || !folds {
+            break;
+        }
+    }
+    best.ok_or_else(|| Error::Internal("homology: no map to relax".into()))
 }
 
 /// Loops as 3D polylines (a1, b1, …) on the basis's refinement, the intersection matrix and the

@@ -105,7 +105,7 @@ impl Grid {
 
     /// The containing triangle reached by walking from the nearest centroid, if the walk finds
     /// one within [`MAX_WALK`] steps without leaving the domain.
-    fn walk(&self, uv: &[Uv], tris: &[[u32; 3]], p: Uv) -> Option<(u32, [f64; 3])> {
+    fn walk(&self, uv: &[Uv], tris: &[[u32; 3]], p: Uv, slab: bool) -> Option<(u32, [f64; 3])> {
         let tree = self.tree.as_ref()?;
         let mut f = tree.query(&p).nearest_one::<SquaredEuclidean<f64>>().execute().item as usize;
         let mut prev = u32::MAX;
@@ -121,7 +121,7 @@ impl Grid {
                 // Beyond a boundary edge and within its slab (a point on the domain's boundary
                 // curve just outside the chord, or rounding): the clamped point on the edge.
                 let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-                if b[i] < 0.0 || b[j] < 0.0 || !b[k].is_finite() {
+                if b[i] < 0.0 || b[j] < 0.0 || !b[k].is_finite() || (!slab && b[k] < -1e-12) {
                     return None;
                 }
                 let mut c = [0.0; 3];
@@ -137,10 +137,16 @@ impl Grid {
         None
     }
 
+    /// The triangle containing `p` when a walk reaches it: `None` for a point outside the
+    /// domain (and, rarely, for one the walk cannot reach across a concave boundary).
+    pub fn locate_inside(&self, uv: &[Uv], tris: &[[u32; 3]], p: Uv) -> Option<(u32, [f64; 3])> {
+        self.walk(uv, tris, p, false)
+    }
+
     /// The triangle containing `p` (or nearest to containing it) and its barycentric
     /// coordinates, clamped to be non-negative and to sum to 1.
     pub fn locate(&self, uv: &[Uv], tris: &[[u32; 3]], p: Uv) -> (u32, [f64; 3]) {
-        if let Some(hit) = self.walk(uv, tris, p) {
+        if let Some(hit) = self.walk(uv, tris, p, true) {
             return hit;
         }
         let cx = (((p[0] - self.lo[0]) / self.cell).max(0.0) as usize).min(self.nx - 1);

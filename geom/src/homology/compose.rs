@@ -22,6 +22,16 @@ pub struct Planar<'a> {
 /// Every original vertex of the `n` vertices of `from`'s mesh (through the first of its disk
 /// copies) located in `to`'s domain after `tau`.
 pub fn locate_all(n: usize, from: &Planar, to: &Planar, tau: &dyn Fn(Uv) -> Uv) -> SurfaceMap {
+    locate_all_by(n, from, to, tau, &|grid, tris, p| grid.locate(to.uv, tris, p))
+}
+
+/// A point location in a disk: `(grid, triangles, point)` to a triangle and barycentric
+/// coordinates.
+pub type Locator<'a> = dyn Fn(&Grid, &[[u32; 3]], Uv) -> (u32, [f64; 3]) + 'a;
+
+/// [`locate_all`] with the point location given: `find(grid, triangles, point)` returns the
+/// triangle of `to`'s disk and the barycentric coordinates there.
+pub fn locate_all_by(n: usize, from: &Planar, to: &Planar, tau: &dyn Fn(Uv) -> Uv, find: &Locator) -> SurfaceMap {
     let mut copy = vec![u32::MAX; n];
     for (d, o) in from.disk.orig.iter().enumerate() {
         if o.idx() < n && copy[o.idx()] == u32::MAX {
@@ -33,8 +43,7 @@ pub fn locate_all(n: usize, from: &Planar, to: &Planar, tau: &dyn Fn(Uv) -> Uv) 
     let mut face = Vec::with_capacity(n);
     let mut bary = Vec::with_capacity(n);
     for &c in &copy {
-        let p = tau(from.uv[c as usize]);
-        let (f, b) = grid.locate(to.uv, &tris, p);
+        let (f, b) = find(&grid, &tris, tau(from.uv[c as usize]));
         let (of, ob) = match to.refined {
             Some(r) => r.to_original(FaceId(f), b),
             None => (FaceId(f), b),

@@ -14,14 +14,13 @@
 //! tori the class fixes the map up to a translation, and the anchor fixes that.
 
 use super::basis::CanonicalBasisResult;
-use super::compose::Planar;
+use super::compose::{Planar, locate_all_by};
 use crate::error::{Error, Result};
 use crate::linalg::{DirectedWeights, FixedBoundarySystem, Weights, directed_weights};
 use crate::map::SurfaceMap;
+use crate::mesh::VertexId;
 use crate::mesh::cut::CutMesh;
-use crate::mesh::{FaceId, VertexId};
 use crate::param::{InjectivityReport, Uv};
-use crate::planar::locate::Grid;
 
 /// Stretch-reweighting rounds at most (Yoshizawa, Belyaev & Seidel 2004, each face's weights
 /// divided by its stretch, so they stay symmetric and positive).
@@ -158,37 +157,19 @@ impl<'a> Lattice<'a> {
 /// located on `to`'s flat torus after `tau`: the lattice translate of the point that falls in
 /// `to`'s fundamental domain (the translate in the square about the origin first, then its
 /// neighbours; a point no walk reaches, which rounding on the domain's rim can leave, is
-/// located as [`Grid::locate`] does, on the nearest triangle).
+/// located as `Grid::locate` does, on the nearest triangle).
 pub fn locate_all_periodic(n: usize, from: &Planar, to: &Planar, period: f64, tau: &dyn Fn(Uv) -> Uv) -> SurfaceMap {
-    let mut copy = vec![u32::MAX; n];
-    for (d, o) in from.disk.orig.iter().enumerate() {
-        if o.idx() < n && copy[o.idx()] == u32::MAX {
-            copy[o.idx()] = d as u32;
-        }
-    }
-    let tris = to.disk.mesh.face_indices();
-    let grid = Grid::new(to.uv, &tris);
     let mut shifts: Vec<[f64; 2]> =
         (-2..=2).flat_map(|i| (-2..=2).map(move |j| [f64::from(i) * period, f64::from(j) * period])).collect();
     shifts.sort_by(|a, b| (a[0].abs() + a[1].abs()).total_cmp(&(b[0].abs() + b[1].abs())));
-    let mut face = Vec::with_capacity(n);
-    let mut bary = Vec::with_capacity(n);
-    for &c in &copy {
-        let p = tau(from.uv[c as usize]);
-        // The translate in the square about the origin first, then its neighbours.
-        let p = [p[0] - (p[0] / period).round() * period, p[1] - (p[1] / period).round() * period];
-        let best = shifts
+    let whole = |x: f64| (x / period).round() * period;
+    locate_all_by(n, from, to, tau, &|grid, tris, p| {
+        let p = [p[0] - whole(p[0]), p[1] - whole(p[1])];
+        shifts
             .iter()
-            .find_map(|s| grid.locate_inside(to.uv, &tris, [p[0] + s[0], p[1] + s[1]]))
-            .unwrap_or_else(|| grid.locate(to.uv, &tris, p));
-        let (of, ob) = match to.refined {
-            Some(r) => r.to_original(FaceId(best.0), best.1),
-            None => (FaceId(best.0), best.1),
-        };
-        face.push(of);
-        bary.push(ob);
-    }
-    SurfaceMap { face, bary }
+            .find_map(|s| grid.locate_inside(to.uv, tris, [p[0] + s[0], p[1] + s[1]]))
+            .unwrap_or_else(|| grid.locate(to.uv, tris, p))
+    })
 }
 
 /// Mean-value weights (Floater 2003) made symmetric, each face's two directed weights of an edge

@@ -218,11 +218,8 @@ fn through_square(
     if warped {
         s.domain.injectivity = super::domain::exact_orientation(&s.basis.disk.mesh, &s.domain.uv);
     }
-    Ok(Composed {
-        source_to_target: locate_all(source.n_vertices(), &s.planar(), &t.planar(), &|p| rotated(p, angle)),
-        target_to_source: locate_all(target.n_vertices(), &t.planar(), &s.planar(), &|p| rotated(p, -angle)),
-        warped,
-    })
+    let locate = |n: usize, from: &Planar, to: &Planar, a: f64| locate_all(n, from, to, &|p| rotated(p, a));
+    Ok(both_ways((source, target), (&s.planar(), &t.planar()), angle, warped, &locate))
 }
 
 /// Through the two flat tori (genus 1, both bijective), the source's turned by `angle`.
@@ -240,11 +237,24 @@ fn through_flat(
     let warped = warp_interior(&s.basis.disk, &mut sf.uv, &s.basis.walk, &tp, anchors, &|p| rotated(p, -angle))?;
     let period = sf.period;
     let sp = Planar { disk: &s.basis.disk, uv: &sf.uv, refined: Some(&s.basis.refined) };
-    Ok(Some(Composed {
-        source_to_target: locate_all_periodic(source.n_vertices(), &sp, &tp, period, &|p| rotated(p, angle)),
-        target_to_source: locate_all_periodic(target.n_vertices(), &tp, &sp, period, &|p| rotated(p, -angle)),
+    let locate =
+        |n: usize, from: &Planar, to: &Planar, a: f64| locate_all_periodic(n, from, to, period, &|p| rotated(p, a));
+    Ok(Some(both_ways((source, target), (&sp, &tp), angle, warped, &locate)))
+}
+
+/// Both directions located by `locate(vertices, from, to, angle)`, the source turned by `angle`.
+fn both_ways(
+    (source, target): (&Mesh, &Mesh),
+    (sp, tp): (&Planar, &Planar),
+    angle: f64,
+    warped: bool,
+    locate: &dyn Fn(usize, &Planar, &Planar, f64) -> SurfaceMap,
+) -> Composed {
+    Composed {
+        source_to_target: locate(source.n_vertices(), sp, tp, angle),
+        target_to_source: locate(target.n_vertices(), tp, sp, -angle),
         warped,
-    }))
+    }
 }
 
 /// The evaluator's L2 stretch of `map`'s chords (infinite for a map that cannot be embedded).

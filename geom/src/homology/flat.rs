@@ -191,15 +191,21 @@ mod tests {
     use crate::homology::{CanonicalBasisOptions, canonical_basis, fundamental_domain};
     use crate::mesh::shapes;
 
+    /// A torus of revolution's canonical basis and its flat torus.
+    fn flat_of_torus(n: usize, m: usize, r: f64) -> (CanonicalBasisResult, FlatTorusResult) {
+        let mesh = shapes::torus(n, m, 2.0, r);
+        let basis = canonical_basis(&mesh, VertexId(0), &CanonicalBasisOptions::default()).unwrap();
+        let square = fundamental_domain(&basis, 0).unwrap();
+        let flat = flat_torus(&basis, &square.uv).unwrap();
+        (basis, flat)
+    }
+
     /// A torus of revolution: the periodic embedding is bijective, the copies of every cut
     /// vertex differ by whole periods, and the disk tiles one lattice cell (its signed area is
     /// `period²`), which is what makes it a fundamental domain; the solve's residual is small.
     #[test]
     fn a_torus_lies_on_one_cell_of_its_lattice() {
-        let m = shapes::torus(32, 14, 2.0, 0.6);
-        let basis = canonical_basis(&m, VertexId(0), &CanonicalBasisOptions::default()).unwrap();
-        let square = fundamental_domain(&basis, 0).unwrap();
-        let flat = flat_torus(&basis, &square.uv).unwrap();
+        let (basis, flat) = flat_of_torus(32, 14, 0.6);
         assert!(flat.injectivity.is_injective(), "{:?}", flat.injectivity);
         assert!(flat.residual < 1e-10, "residual {}", flat.residual);
         let p = flat.period;
@@ -232,10 +238,7 @@ mod tests {
     /// cells are each located on a triangle that contains them up to a lattice translate.
     #[test]
     fn every_translate_is_found_in_the_domain() {
-        let m = shapes::torus(24, 10, 2.0, 0.7);
-        let basis = canonical_basis(&m, VertexId(0), &CanonicalBasisOptions::default()).unwrap();
-        let square = fundamental_domain(&basis, 0).unwrap();
-        let flat = flat_torus(&basis, &square.uv).unwrap();
+        let (basis, flat) = flat_of_torus(24, 10, 0.7);
         let planar = Planar { disk: &basis.disk, uv: &flat.uv, refined: None };
         let tris = basis.disk.mesh.face_indices();
         // Move every disk vertex by a fraction of a period and by up to one whole period: the

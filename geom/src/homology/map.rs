@@ -26,8 +26,6 @@ pub struct HomologyMapOptions {
     pub max_subdivisions: Option<usize>,
     /// Stretch-minimizing reweighting rounds of each domain map.
     pub stretch_iterations: usize,
-    /// Genus 1: compose through the 4g-gons even where both flat tori exist.
-    pub square: bool,
 }
 
 /// One side's basis and domain.
@@ -124,7 +122,7 @@ pub fn homology_map(
     });
     let (s, t) = (s?, t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??);
     let (s, t) = aligned((s, t), &mut |min| side(source, bases.0, 0, min), &mut |min| side(target, bases.1, 1, min))?;
-    map_between(source, target, s, t, opts.rotation, anchors, opts.square)
+    map_between(source, target, s, t, opts.rotation, anchors, false)
 }
 
 /// Both meshes refined alike: the side found at an earlier attempt is searched again up to the
@@ -152,7 +150,8 @@ pub fn aligned(
     Ok((s, t))
 }
 
-/// Composes two sides' domains under rotation `rotation`.
+/// Composes two sides' domains under rotation `rotation`; genus 1 through the flat tori unless
+/// `square` (or one flat torus is missing).
 ///
 /// # Errors
 /// `InvalidInput` when the genera differ.
@@ -172,11 +171,11 @@ pub fn map_between(
     let m = 4 * g;
     let shift = if g == 1 { rotation % 4 } else { 4 * (rotation % g) };
     let angle = std::f64::consts::TAU * shift as f64 / m as f64;
-    // Genus 1: through the flat tori unless asked otherwise or one is not bijective.
-    let flat = if square { None } else { through_flat(source, target, &mut s, &t, angle, anchors)? };
+    let c = Composer { source, target, angle, anchors };
+    let flat = if square { None } else { c.through_flat(&mut s, &t)? };
     let (composed, flat) = match flat {
         Some(f) => (f, true),
-        None => (through_square(source, target, &mut s, &t, angle, anchors)?, false),
+        None => (c.through_square(&mut s, &t)?, false),
     };
     let Composed { source_to_target, target_to_source, warped } = composed;
     let h1 = induced_h1(&s.basis, &t.basis, shift);
@@ -203,57 +202,56 @@ fn rotated(p: Uv, a: f64) -> Uv {
     [p[0] * a.cos() - p[1] * a.sin(), p[0] * a.sin() + p[1] * a.cos()]
 }
 
-/// Through the two 4g-gons, the source's turned by `angle` (its interior warped onto the anchors
-/// when that stays bijective).
-fn through_square(
-    source: &Mesh,
-    target: &Mesh,
-    s: &mut SideDomain,
-    t: &SideDomain,
+/// What both compositions share: the meshes, the source domain's turn and the anchors.
+struct Composer<'a> {
+    source: &'a Mesh,
+    target: &'a Mesh,
     angle: f64,
-    anchors: &[(VertexId, VertexId)],
-) -> Result<Composed> {
-    let warped =
-        warp_interior(&s.basis.disk, &mut s.domain.uv, &s.basis.walk, &t.planar(), anchors, &|p| rotated(p, -angle))?;
-    if warped {
-        s.domain.injectivity = super::domain::exact_orientation(&s.basis.disk.mesh, &s.domain.uv);
+    anchors: &'a [(VertexId, VertexId)],
+}
+
+impl Composer<'_> {
+    /// Through the two 4g-gons, the source's turned by `angle` (its interior warped onto the
+    /// anchors when that stays bijective).
+    fn through_square(&self, s: &mut SideDomain, t: &SideDomain) -> Result<Composed> {
+        let angle = self.angle;
+        let warped = warp_interior(&s.basis.disk, &mut s.domain.uv, &s.basis.walk, &t.planar(), self.anchors, &|p| {
+            rotated(p, -angle)
+        })?;
+        if warped {
+            s.domain.injectivity = super::domain::exact_orientation(&s.basis.disk.mesh, &s.domain.uv);
+        }
+        let locate = |n: usize, from: &Planar, to: &Planar, a: f64| locate_all(n, from, to, &|p| rotated(p, a));
+        Ok(self.both_ways((&s.planar(), &t.planar()), warped, &locate))
     }
-    let locate = |n: usize, from: &Planar, to: &Planar, a: f64| locate_all(n, from, to, &|p| rotated(p, a));
-    Ok(both_ways((source, target), (&s.planar(), &t.planar()), angle, warped, &locate))
-}
 
-/// Through the two flat tori (genus 1, both bijective), the source's turned by `angle`.
-fn through_flat(
-    source: &Mesh,
-    target: &Mesh,
-    s: &mut SideDomain,
-    t: &SideDomain,
-    angle: f64,
-    anchors: &[(VertexId, VertexId)],
-) -> Result<Option<Composed>> {
-    let (Some(sf), Some(tp)) = (s.flat.as_mut(), t.flat_planar()) else {
-        return Ok(None);
-    };
-    let warped = warp_interior(&s.basis.disk, &mut sf.uv, &s.basis.walk, &tp, anchors, &|p| rotated(p, -angle))?;
-    let period = sf.period;
-    let sp = Planar { disk: &s.basis.disk, uv: &sf.uv, refined: Some(&s.basis.refined) };
-    let locate =
-        |n: usize, from: &Planar, to: &Planar, a: f64| locate_all_periodic(n, from, to, period, &|p| rotated(p, a));
-    Ok(Some(both_ways((source, target), (&sp, &tp), angle, warped, &locate)))
-}
+    /// Through the two flat tori (genus 1, both bijective), the source's turned by `angle`.
+    fn through_flat(&self, s: &mut SideDomain, t: &SideDomain) -> Result<Option<Composed>> {
+        let (Some(sf), Some(tp)) = (s.flat.as_mut(), t.flat_planar()) else {
+            return Ok(None);
+        };
+        let angle = self.angle;
+        let warped =
+            warp_interior(&s.basis.disk, &mut sf.uv, &s.basis.walk, &tp, self.anchors, &|p| rotated(p, -angle))?;
+        let period = sf.period;
+        let sp = Planar { disk: &s.basis.disk, uv: &sf.uv, refined: Some(&s.basis.refined) };
+        let locate =
+            |n: usize, from: &Planar, to: &Planar, a: f64| locate_all_periodic(n, from, to, period, &|p| rotated(p, a));
+        Ok(Some(self.both_ways((&sp, &tp), warped, &locate)))
+    }
 
-/// Both directions located by `locate(vertices, from, to, angle)`, the source turned by `angle`.
-fn both_ways(
-    (source, target): (&Mesh, &Mesh),
-    (sp, tp): (&Planar, &Planar),
-    angle: f64,
-    warped: bool,
-    locate: &dyn Fn(usize, &Planar, &Planar, f64) -> SurfaceMap,
-) -> Composed {
-    Composed {
-        source_to_target: locate(source.n_vertices(), sp, tp, angle),
-        target_to_source: locate(target.n_vertices(), tp, sp, -angle),
-        warped,
+    /// Both directions located by `locate(vertices, from, to, angle)`.
+    fn both_ways(
+        &self,
+        (sp, tp): (&Planar, &Planar),
+        warped: bool,
+        locate: &dyn Fn(usize, &Planar, &Planar, f64) -> SurfaceMap,
+    ) -> Composed {
+        Composed {
+            source_to_target: locate(self.source.n_vertices(), sp, tp, self.angle),
+            target_to_source: locate(self.target.n_vertices(), tp, sp, -self.angle),
+            warped,
+        }
     }
 }
 

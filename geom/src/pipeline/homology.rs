@@ -11,6 +11,7 @@ use super::spec::HomologySpec;
 use super::spec::RelaxOptions;
 use crate::error::{Error, Result};
 use crate::homology::map::SideDomain;
+use crate::homology::map::map_between;
 use crate::homology::matching::{reference_frame, reference_h1};
 use crate::homology::{HomologyMapOptions, HomologyMapResult, homology_map};
 use crate::mesh::{Mesh, VertexId};
@@ -36,8 +37,9 @@ pub struct HomologyReport {
     pub side_shift: usize,
     /// Whether the source domain was warped onto the anchors (constrained mean-value map).
     pub anchor_warp: bool,
-    /// Genus 1: whether the maps went through the two flat tori (`homology::flat`), the less
-    /// stretched composition; else through the 4g-gons.
+    /// Genus 1: whether the maps went through the two flat tori (`homology::flat`); false when
+    /// either is not bijective, or when their map folded after relaxation and the 4g-gons' did
+    /// better.
     pub flat_torus: bool,
     /// Induced map on H1 (`a1, b1, …`), column `j` the image of source loop `j`.
     pub h1: Vec<Vec<i32>>,
@@ -84,8 +86,7 @@ pub fn run(
     let mut best: Option<(usize, HomologyMapResult, FinishedPair)> = None;
     for (i, &(basis, rotation)) in plan.tries.iter().enumerate() {
         let (r, f) = relax_class(source, target, &pairs, basis, rotation, &o.relax(), progress)?;
-        let out =
-            Relaxed { flips: [f.m1.flipped_faces, f.m2.flipped_faces], l2_stretch: [f.m1.l2_stretch, f.m2.l2_stretch] };
+        let out = Relaxed::of(&f);
         relaxed.push(out);
         if best.as_ref().is_none_or(|(b, ..)| out.better_than(&relaxed[*b])) {
             best = Some((i, r, f));
@@ -174,8 +175,9 @@ pub fn run(
 }
 
 /// One class built and relaxed. A genus-1 class goes through the flat tori first; if that map
-/// folds after relaxation, the square domains' map is relaxed too and the better stands
-/// (between different shapes the flat tori can differ more than the squares' interiors do).
+/// folds after relaxation, the squares' map of the same bases is relaxed too and the better
+/// stands (between different shapes the flat tori can differ more than the squares' interiors
+/// do).
 fn relax_class(
     source: &Mesh,
     target: &Mesh,
@@ -185,42 +187,28 @@ fn relax_class(
     relax: &RelaxOptions,
     progress: &mut dyn Progress,
 ) -> Result<(HomologyMapResult, FinishedPair)> {
-    let mut best: Option<(HomologyMapResult, FinishedPair)> = None;
-    for square in [false, true] {
-        let hopts = HomologyMapOptions {
-            basis,
-            rotation,
-            max_subdivisions: None,
-            // Reweighting each domain on its own lowers each map's stretch but raised the
-            // composed map's folds on every different-shape pair measured (bench/NOTES.md).
-            stretch_iterations: 0,
-            square,
-        };
-        let r = homology_map(source, target, pairs[0], &pairs[1..], &hopts)?;
-        progress.check()?;
-        let f = finish_pair(
-            source,
-            target,
-            (&r.source_to_target, &r.target_to_source),
-            pairs,
-            (&[], &[]),
-            relax,
-            progress,
-        )?;
-        let key = |f: &FinishedPair| Relaxed {
-            flips: [f.m1.flipped_faces, f.m2.flipped_faces],
-            l2_stretch: [f.m1.l2_stretch, f.m2.l2_stretch],
-        };
-        let flat = r.flat;
-        if best.as_ref().is_none_or(|(_, b)| key(&f).better_than(&key(b))) {
-            best = Some((r, f));
-        }
-        let folds = best.as_ref().is_some_and(|(_, b)| key(b).flips != [0, 0]);
-        if !flat || !folds {
-            break;
-        }
+    let hopts = HomologyMapOptions {
+        basis,
+        rotation,
+        max_subdivisions: None,
+        // Reweighting each domain on its own lowers each map's stretch but raised the
+        // composed map's folds on every different-shape pair measured (bench/NOTES.md).
+        stretch_iterations: 0,
+    };
+    let anchors = &pairs[1..];
+    let finish = |r: &HomologyMapResult, progress: &mut dyn Progress| {
+        finish_pair(source, target, (&r.source_to_target, &r.target_to_source), pairs, (&[], &[]), relax, progress)
+    };
+    let r = homology_map(source, target, pairs[0], anchors, &hopts)?;
+    progress.check()?;
+    let f = finish(&r, progress)?;
+    if !r.flat || Relaxed::of(&f).flips == [0, 0] {
+        return Ok((r, f));
     }
-    best.ok_or_else(|| Error::Internal("homology: no map to relax".into()))
+    let sq = map_between(source, target, r.source.clone(), r.target.clone(), rotation, anchors, true)?;
+    progress.check()?;
+    let g = finish(&sq, progress)?;
+    Ok(if Relaxed::of(&g).better_than(&Relaxed::of(&f)) { (sq, g) } else { (r, f) })
 }
 
 /// Loops as 3D polylines (a1, b1, …) on the basis's refinement, the intersection matrix and the

@@ -94,6 +94,11 @@ pub struct Relaxed {
 }
 
 impl Relaxed {
+    /// The outcome of a relaxed pair.
+    pub fn of(f: &super::common::relax::FinishedPair) -> Relaxed {
+        Relaxed { flips: [f.m1.flipped_faces, f.m2.flipped_faces], l2_stretch: [f.m1.l2_stretch, f.m2.l2_stretch] }
+    }
+
     pub fn better_than(&self, o: &Relaxed) -> bool {
         let key = |r: &Relaxed| (r.flips[0] + r.flips[1], 0.5 * (r.l2_stretch[0] + r.l2_stretch[1]));
         let (a, b) = (key(self), key(o));

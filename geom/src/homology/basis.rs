@@ -129,69 +129,77 @@ pub fn canonical_basis_avoiding(
         );
     }
     let g = s.genus as usize;
-    let mut refined = Refined::identity(mesh);
-    let mut curves = avoid.to_vec();
-    refine_with(&mut refined, &mut curves, |r| r.raise_valence(base, 8 * g + 8))?;
-    for round in 0..=opts.max_subdivisions {
-        // A crowded base vertex first gets more edges (twice, then four times as many); loops
-        // that pen the corner in (neighbouring loop vertices joined by an edge) get those
-        // edges split, which opens an interior vertex between them.
-        let mut local = refined.clone();
-        let mut local_curves = curves.clone();
-        for extra in 0..ATTEMPTS_PER_ROUND {
-            let attempt = round * ATTEMPTS_PER_ROUND + extra;
-            let t0 = std::time::Instant::now();
-            let blocked = blocked_by(&local.mesh, &local_curves);
-            let mut res = search(&local.mesh, &blocked, base, g, opts.basis_index)?;
-            // With walls, the first handle's class can leave a later handle no room where the
-            // next classes do: try those before refining (the stuck search's loops still
-            // decide the refinement). Without walls nothing changes.
-            if res.is_err() && !blocked.is_empty() && attempt >= opts.min_attempt {
-                for k in 1..=WALLED_EXTRA_CLASSES {
-                    if let Ok(loops) = search(&local.mesh, &blocked, base, g, opts.basis_index + k)? {
-                        res = Ok(loops);
-                        break;
-                    }
-                }
-            }
-            debug(|| {
-                format!(
-                    "attempt round {round} extra {extra}: {} vertices, {:.2} s, {}",
-                    local.mesh.n_vertices(),
-                    t0.elapsed().as_secs_f64(),
-                    if res.is_ok() { "found" } else { "stuck" }
-                )
-            });
-            let partial = match res {
-                Ok(loops) if attempt >= opts.min_attempt => {
-                    return finish(local, base, loops, local_curves, round, attempt);
-                }
-                Ok(loops) | Err(loops) => loops,
-            };
-            // Loops that pen a corner in leave no vertex between them: split every edge at
-            // their vertices (a band of new vertices along each loop); a crowded base vertex
-            // gets twice its edges; chords joining loop vertices are split. Then search again.
-            // The second failure takes the whole remedy at once (the loops found so far are
-            // threaded through each step); later ones take one step each.
-            let mut partial = partial;
-            for &step in REFINE_STEPS[extra.min(REFINE_STEPS.len() - 1)] {
-                let before = local.mesh.clone();
-                refine_with(&mut local, &mut local_curves, |r| match step {
-                    Step::Band => r.split_edges(&band_of(&r.mesh, &partial, base)),
-                    Step::Chords => r.split_edges(&chords_of(&r.mesh, &partial)),
-                    Step::Valence => {
-                        let valence = r.mesh.outgoing(base).count();
-                        r.raise_valence(base, 2 * valence)
-                    }
-                })?;
-                match rethread(&before, &local.mesh, &partial) {
-                    Some(p) => partial = p,
-                    None => break,
-                }
-            }
+    // The greedy search through every refinement first; only when it finds no basis at all,
+    // the same attempts again with backtracking (a pass's attempts number after the last's).
+    let per_pass = (opts.max_subdivisions + 1) * ATTEMPTS_PER_ROUND;
+    for (pass, detours) in [0, MAX_DETOURS].into_iter().enumerate() {
+        if opts.min_attempt >= (pass + 1) * per_pass {
+            continue;
         }
-        if round < opts.max_subdivisions {
-            refine_with(&mut refined, &mut curves, |r| r.subdivide()?.raise_valence(base, 8 * g + 8))?;
+        let mut refined = Refined::identity(mesh);
+        let mut curves = avoid.to_vec();
+        refine_with(&mut refined, &mut curves, |r| r.raise_valence(base, 8 * g + 8))?;
+        for round in 0..=opts.max_subdivisions {
+            // A crowded base vertex first gets more edges (twice, then four times as many); loops
+            // that pen the corner in (neighbouring loop vertices joined by an edge) get those
+            // edges split, which opens an interior vertex between them.
+            let mut local = refined.clone();
+            let mut local_curves = curves.clone();
+            for extra in 0..ATTEMPTS_PER_ROUND {
+                let attempt = pass * per_pass + round * ATTEMPTS_PER_ROUND + extra;
+                let t0 = std::time::Instant::now();
+                let blocked = blocked_by(&local.mesh, &local_curves);
+                let mut res = search(&local.mesh, &blocked, base, g, opts.basis_index, detours)?;
+                // With walls, the first handle's class can leave a later handle no room where the
+                // next classes do: try those before refining (the stuck search's loops still
+                // decide the refinement). Without walls nothing changes.
+                if res.is_err() && !blocked.is_empty() && attempt >= opts.min_attempt {
+                    for k in 1..=WALLED_EXTRA_CLASSES {
+                        if let Ok(loops) = search(&local.mesh, &blocked, base, g, opts.basis_index + k, detours)? {
+                            res = Ok(loops);
+                            break;
+                        }
+                    }
+                }
+                debug(|| {
+                    format!(
+                        "attempt pass {pass} round {round} extra {extra}: {} vertices, {:.2} s, {}",
+                        local.mesh.n_vertices(),
+                        t0.elapsed().as_secs_f64(),
+                        if res.is_ok() { "found" } else { "stuck" }
+                    )
+                });
+                let partial = match res {
+                    Ok(loops) if attempt >= opts.min_attempt => {
+                        return finish(local, base, loops, local_curves, round, attempt);
+                    }
+                    Ok(loops) | Err(loops) => loops,
+                };
+                // Loops that pen a corner in leave no vertex between them: split every edge at
+                // their vertices (a band of new vertices along each loop); a crowded base vertex
+                // gets twice its edges; chords joining loop vertices are split. Then search again.
+                // The second failure takes the whole remedy at once (the loops found so far are
+                // threaded through each step); later ones take one step each.
+                let mut partial = partial;
+                for &step in REFINE_STEPS[extra.min(REFINE_STEPS.len() - 1)] {
+                    let before = local.mesh.clone();
+                    refine_with(&mut local, &mut local_curves, |r| match step {
+                        Step::Band => r.split_edges(&band_of(&r.mesh, &partial, base)),
+                        Step::Chords => r.split_edges(&chords_of(&r.mesh, &partial)),
+                        Step::Valence => {
+                            let valence = r.mesh.outgoing(base).count();
+                            r.raise_valence(base, 2 * valence)
+                        }
+                    })?;
+                    match rethread(&before, &local.mesh, &partial) {
+                        Some(p) => partial = p,
+                        None => break,
+                    }
+                }
+            }
+            if round < opts.max_subdivisions {
+                refine_with(&mut refined, &mut curves, |r| r.subdivide()?.raise_valence(base, 8 * g + 8))?;
+            }
         }
     }
     let walls = if avoid.is_empty() {
@@ -267,39 +275,104 @@ const REFINE_STEPS: [&[Step]; 6] = [
     &[Step::Band],
 ];
 
-/// Handle by handle on the surface cut so far; `None` when loops would have to touch.
+/// Handle by handle on the surface cut so far; `Err(partial)` when loops would have to touch.
 /// Each handle tries the corners between commutators (most reachable interior first) and, at
-/// each, the shortest few non-separating classes, until one admits its crossing loop.
+/// each, the shortest few non-separating classes, until one admits its crossing loop. When a
+/// later handle finds no room, the search backtracks: the earlier handles' other classes and
+/// corners are tried (after at most `max_detours` dead ends it gives up; 0 is the greedy
+/// search), since a lasso cut beside an earlier loop can pen the next corners into pockets
+/// that another choice leaves open. The greedy path is tried first; a stuck search reports the
+/// greedy path's loops, which direct the refinement.
 fn search(
     mesh: &Mesh,
     blocked: &[bool],
     base: VertexId,
     g: usize,
     first: usize,
+    max_detours: usize,
 ) -> Result<std::result::Result<Loops, Loops>> {
-    let mut s = CutMesh { mesh: mesh.clone(), orig: (0..mesh.n_vertices()).map(VertexId::from_idx).collect() };
-    let mut walls = blocked.to_vec();
-    let mut corners = vec![base];
-    let mut loops: Vec<Vec<VertexId>> = Vec::with_capacity(2 * g);
-    for handle in 0..g {
-        let mut done = None;
-        'corners: for &corner in &corners {
+    let s = CutMesh { mesh: mesh.clone(), orig: (0..mesh.n_vertices()).map(VertexId::from_idx).collect() };
+    let mut h = Handles { blocked, base, g, first, max_detours, detours: 0, partial: None };
+    let found = h.descend(0, s, blocked.to_vec(), vec![base], Vec::with_capacity(2 * g))?;
+    Ok(found.ok_or_else(|| h.partial.unwrap_or_default()))
+}
+
+/// Dead ends the backtracking basis search may back out of before it gives up (genus3 seed 1
+/// needs about a dozen; each costs a few cuts and searches, see bench/NOTES.md).
+const MAX_DETOURS: usize = 30;
+
+/// The state shared by the levels of the backtracking search.
+struct Handles<'a> {
+    blocked: &'a [bool],
+    base: VertexId,
+    g: usize,
+    first: usize,
+    max_detours: usize,
+    detours: usize,
+    /// The first dead end's loops (the greedy path's).
+    partial: Option<Loops>,
+}
+
+impl Handles<'_> {
+    /// Cuts handles `handle..g` from `s`, whose earlier loops are `loops`; `None` at a dead end
+    /// (recorded) or when the detour budget is spent.
+    fn descend(
+        &mut self,
+        handle: usize,
+        s: CutMesh,
+        walls: Vec<bool>,
+        corners: Vec<VertexId>,
+        loops: Loops,
+    ) -> Result<Option<Loops>> {
+        if handle == self.g {
+            return Ok(Some(loops));
+        }
+        let blocked = self.blocked;
+        let mut out = None;
+        let mut admitted = 0;
+        for &corner in &corners {
             // With walls (feature curves) the first handle may also try the next two classes:
             // a loop that runs beside a curve can leave its crossing path no room.
             let extra = if blocked.is_empty() { 0 } else { WALLED_EXTRA_CLASSES };
-            let (skip, count) = if handle == 0 { (first, first + 1 + extra) } else { (0, 3) };
-            // Candidates one at a time: the first that admits its crossing loop ends the search.
+            let (skip, count) = if handle == 0 { (self.first, self.first + 1 + extra) } else { (0, 3) };
+            // Candidates one at a time: the first whose handle leads to a whole basis ends it.
             let mut seen = 0;
             let n_cands = each_nonseparating_loop(&s.mesh, &walls, corner, count, &mut |a| {
                 seen += 1;
-                if seen <= skip {
-                    return Ok(false);
+                if seen <= skip || self.exhausted() {
+                    return Ok(self.exhausted());
                 }
-                done = cross(&s, blocked, corner, &a, handle == 0)?;
-                Ok(done.is_some())
+                let Some((a, b, s1_orig_b, s2)) = cross(&s, blocked, corner, &a, handle == 0)? else {
+                    return Ok(false);
+                };
+                admitted += 1;
+                let mut next = loops.clone();
+                next.push(a.iter().map(|&v| s.orig[v.idx()]).collect());
+                next.push(b.iter().map(|&v| s1_orig_b[v.idx()]).collect());
+                let Some(w) = read_word(&s2.mesh, &s2.orig, self.base, &next) else {
+                    debug(|| format!("handle {handle}: cut surface word unreadable"));
+                    self.dead_end(next);
+                    return Ok(false);
+                };
+                // Any corner between commutators will do: most reachable interior first (loops
+                // that run side by side can pen a corner into a small pocket), then the widest.
+                let mut cs: Vec<VertexId> =
+                    canonical_rotations(&w.letters).into_iter().map(|r| w.walk[w.corners[r]]).collect();
+                if cs.is_empty() {
+                    return Err(Error::Internal(format!("basis: handle {} left a non-canonical word", handle + 1)));
+                }
+                let walls2 = blocked_on(&s2, blocked);
+                {
+                    let reach = interior_components(&s2.mesh, &walls2);
+                    cs.sort_by_key(|&c| {
+                        std::cmp::Reverse((reach(c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0)))
+                    });
+                }
+                out = self.descend(handle + 1, s2, walls2, cs, next)?;
+                Ok(out.is_some() || self.exhausted())
             })?;
-            if done.is_some() {
-                break 'corners;
+            if out.is_some() || self.exhausted() {
+                break;
             }
             debug(|| {
                 format!(
@@ -310,28 +383,23 @@ fn search(
                 )
             });
         }
-        let Some((a, b, s1_orig_b, s2)) = done else { return Ok(Err(loops)) };
-        loops.push(a.iter().map(|&v| s.orig[v.idx()]).collect());
-        loops.push(b.iter().map(|&v| s1_orig_b[v.idx()]).collect());
-        let Some(w) = read_word(&s2.mesh, &s2.orig, base, &loops) else {
-            debug(|| format!("handle {handle}: cut surface word unreadable"));
-            return Ok(Err(loops));
-        };
-        // Any corner between commutators will do: most reachable interior first (loops that
-        // run side by side can pen a corner into a small pocket), then the widest.
-        corners = canonical_rotations(&w.letters).into_iter().map(|r| w.walk[w.corners[r]]).collect();
-        if corners.is_empty() {
-            return Err(Error::Internal(format!("basis: handle {} left a non-canonical word", handle + 1)));
+        if out.is_none() && admitted == 0 {
+            self.dead_end(loops);
         }
-        walls = blocked_on(&s2, blocked);
-        {
-            let reach = interior_components(&s2.mesh, &walls);
-            corners
-                .sort_by_key(|&c| std::cmp::Reverse((reach(c), s2.mesh.outgoing(c).count(), std::cmp::Reverse(c.0))));
-        }
-        s = s2;
+        Ok(out)
     }
-    Ok(Ok(loops))
+
+    fn exhausted(&self) -> bool {
+        self.detours > self.max_detours
+    }
+
+    /// Records a dead end: the first one's loops are the search's partial result.
+    fn dead_end(&mut self, loops: Loops) {
+        self.detours += 1;
+        if self.partial.is_none() {
+            self.partial = Some(loops);
+        }
+    }
 }
 
 type Loops = Vec<Vec<VertexId>>;

@@ -8,7 +8,7 @@ use super::basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis}
 use super::compose::{Planar, locate_all, warp_interior};
 use super::domain::{FundamentalDomainResult, fundamental_domain};
 use super::flat::{FlatTorusResult, flat_torus, locate_all_periodic};
-use crate::error::{InputError, Result};
+use crate::error::{Error, InputError, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
 use crate::param::Uv;
@@ -127,10 +127,11 @@ pub fn homology_map(
 
 /// Both meshes refined alike: the side found at an earlier attempt is searched again up to the
 /// other's attempt (`again_s(min_attempt)`, `again_t`), so that one shape is cut by the same
-/// loops on both meshes.
+/// loops on both meshes. Alignment is a preference: when the later search finds no basis (a
+/// refinement can pen a corner in that a coarser mesh leaves open), the sides found stand.
 ///
 /// # Errors
-/// What the searches report.
+/// What the searches report, except `InvalidInput` (no basis at that attempt).
 pub fn aligned(
     (mut s, mut t): (SideDomain, SideDomain),
     again_s: &mut dyn FnMut(usize) -> Result<SideDomain>,
@@ -141,10 +142,12 @@ pub fn aligned(
         if a == b {
             break;
         }
-        if a < b {
-            s = again_s(b)?;
-        } else {
-            t = again_t(a)?;
+        let again = if a < b { again_s(b) } else { again_t(a) };
+        match again {
+            Ok(x) if a < b => s = x,
+            Ok(x) => t = x,
+            Err(Error::Input(_)) => break,
+            Err(e) => return Err(e),
         }
     }
     Ok((s, t))

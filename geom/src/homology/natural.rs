@@ -96,6 +96,7 @@ pub fn natural_classes(
             };
             for c in a?.into_iter().chain(b) {
                 composed += 1;
+                tracing::debug!(basis = ?c.basis, rotation = c.rotation, stretch = c.stretch, h1 = ?c.h1_reference, "natural class composed");
                 match found.iter_mut().find(|x| x.h1_reference == c.h1_reference) {
                     Some(x) if x.stretch <= c.stretch => {}
                     Some(x) => *x = c,

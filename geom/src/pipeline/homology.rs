@@ -87,6 +87,7 @@ pub fn run(
     for (i, &(basis, rotation)) in plan.tries.iter().enumerate() {
         let (r, f) = relax_class(source, target, &pairs, basis, rotation, &o.relax(), progress)?;
         let out = Relaxed::of(&f);
+        tracing::debug!(?basis, rotation, flips = ?out.flips, l2 = ?out.l2_stretch, "homology class relaxed");
         relaxed.push(out);
         if best.as_ref().is_none_or(|(b, ..)| out.better_than(&relaxed[*b])) {
             best = Some((i, r, f));

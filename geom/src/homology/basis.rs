@@ -130,76 +130,12 @@ pub fn canonical_basis_avoiding(
     }
     let g = s.genus as usize;
     // The greedy search through every refinement first; only when it finds no basis at all,
-    // the same attempts again with backtracking (a pass's attempts number after the last's).
-    let per_pass = (opts.max_subdivisions + 1) * ATTEMPTS_PER_ROUND;
-    for (pass, detours) in [0, MAX_DETOURS].into_iter().enumerate() {
-        if opts.min_attempt >= (pass + 1) * per_pass {
-            continue;
-        }
-        let mut refined = Refined::identity(mesh);
-        let mut curves = avoid.to_vec();
-        refine_with(&mut refined, &mut curves, |r| r.raise_valence(base, 8 * g + 8))?;
-        for round in 0..=opts.max_subdivisions {
-            // A crowded base vertex first gets more edges (twice, then four times as many); loops
-            // that pen the corner in (neighbouring loop vertices joined by an edge) get those
-            // edges split, which opens an interior vertex between them.
-            let mut local = refined.clone();
-            let mut local_curves = curves.clone();
-            for extra in 0..ATTEMPTS_PER_ROUND {
-                let attempt = pass * per_pass + round * ATTEMPTS_PER_ROUND + extra;
-                let t0 = std::time::Instant::now();
-                let blocked = blocked_by(&local.mesh, &local_curves);
-                let mut res = search(&local.mesh, &blocked, base, g, opts.basis_index, detours)?;
-                // With walls, the first handle's class can leave a later handle no room where the
-                // next classes do: try those before refining (the stuck search's loops still
-                // decide the refinement). Without walls nothing changes.
-                if res.is_err() && !blocked.is_empty() && attempt >= opts.min_attempt {
-                    for k in 1..=WALLED_EXTRA_CLASSES {
-                        if let Ok(loops) = search(&local.mesh, &blocked, base, g, opts.basis_index + k, detours)? {
-                            res = Ok(loops);
-                            break;
-                        }
-                    }
-                }
-                debug(|| {
-                    format!(
-                        "attempt pass {pass} round {round} extra {extra}: {} vertices, {:.2} s, {}",
-                        local.mesh.n_vertices(),
-                        t0.elapsed().as_secs_f64(),
-                        if res.is_ok() { "found" } else { "stuck" }
-                    )
-                });
-                let partial = match res {
-                    Ok(loops) if attempt >= opts.min_attempt => {
-                        return finish(local, base, loops, local_curves, round, attempt);
-                    }
-                    Ok(loops) | Err(loops) => loops,
-                };
-                // Loops that pen a corner in leave no vertex between them: split every edge at
-                // their vertices (a band of new vertices along each loop); a crowded base vertex
-                // gets twice its edges; chords joining loop vertices are split. Then search again.
-                // The second failure takes the whole remedy at once (the loops found so far are
-                // threaded through each step); later ones take one step each.
-                let mut partial = partial;
-                for &step in REFINE_STEPS[extra.min(REFINE_STEPS.len() - 1)] {
-                    let before = local.mesh.clone();
-                    refine_with(&mut local, &mut local_curves, |r| match step {
-                        Step::Band => r.split_edges(&band_of(&r.mesh, &partial, base)),
-                        Step::Chords => r.split_edges(&chords_of(&r.mesh, &partial)),
-                        Step::Valence => {
-                            let valence = r.mesh.outgoing(base).count();
-                            r.raise_valence(base, 2 * valence)
-                        }
-                    })?;
-                    match rethread(&before, &local.mesh, &partial) {
-                        Some(p) => partial = p,
-                        None => break,
-                    }
-                }
-            }
-            if round < opts.max_subdivisions {
-                refine_with(&mut refined, &mut curves, |r| r.subdivide()?.raise_valence(base, 8 * g + 8))?;
-            }
+    // the same refinements again with backtracking. Only the first bases take the second
+    // pass: it costs tens of seconds where the greedy search is stuck (bench/NOTES.md).
+    let passes: &[usize] = if opts.basis_index < BACKTRACKED_BASES { &[0, MAX_DETOURS] } else { &[0] };
+    for (pass, &detours) in passes.iter().enumerate() {
+        if let Some(found) = one_pass(mesh, base, g, opts, avoid, (pass, detours))? {
+            return Ok(found);
         }
     }
     let walls = if avoid.is_empty() {
@@ -214,6 +150,84 @@ pub fn canonical_basis_avoiding(
         opts.max_subdivisions
     ))
     .into())
+}
+
+/// One pass of the basis search over every refinement: `detours` dead ends allowed to each
+/// search (0: greedy); `None` when no refinement gives a basis.
+fn one_pass(
+    mesh: &Mesh,
+    base: VertexId,
+    g: usize,
+    opts: &CanonicalBasisOptions,
+    avoid: &[Vec<VertexId>],
+    (pass, detours): (usize, usize),
+) -> Result<Option<(CanonicalBasisResult, Loops)>> {
+    let mut refined = Refined::identity(mesh);
+    let mut curves = avoid.to_vec();
+    refine_with(&mut refined, &mut curves, |r| r.raise_valence(base, 8 * g + 8))?;
+    for round in 0..=opts.max_subdivisions {
+        // A crowded base vertex first gets more edges (twice, then four times as many); loops
+        // that pen the corner in (neighbouring loop vertices joined by an edge) get those
+        // edges split, which opens an interior vertex between them.
+        let mut local = refined.clone();
+        let mut local_curves = curves.clone();
+        for extra in 0..ATTEMPTS_PER_ROUND {
+            let attempt = round * ATTEMPTS_PER_ROUND + extra;
+            let t0 = std::time::Instant::now();
+            let blocked = blocked_by(&local.mesh, &local_curves);
+            let mut res = search(&local.mesh, &blocked, base, g, opts.basis_index, detours)?;
+            // With walls, the first handle's class can leave a later handle no room where the
+            // next classes do: try those before refining (the stuck search's loops still
+            // decide the refinement). Without walls nothing changes.
+            if res.is_err() && !blocked.is_empty() && attempt >= opts.min_attempt {
+                for k in 1..=WALLED_EXTRA_CLASSES {
+                    if let Ok(loops) = search(&local.mesh, &blocked, base, g, opts.basis_index + k, detours)? {
+                        res = Ok(loops);
+                        break;
+                    }
+                }
+            }
+            debug(|| {
+                format!(
+                    "attempt pass {pass} round {round} extra {extra}: {} vertices, {:.2} s, {}",
+                    local.mesh.n_vertices(),
+                    t0.elapsed().as_secs_f64(),
+                    if res.is_ok() { "found" } else { "stuck" }
+                )
+            });
+            let partial = match res {
+                Ok(loops) if attempt >= opts.min_attempt => {
+                    return finish(local, base, loops, local_curves, round, attempt).map(Some);
+                }
+                Ok(loops) | Err(loops) => loops,
+            };
+            // Loops that pen a corner in leave no vertex between them: split every edge at
+            // their vertices (a band of new vertices along each loop); a crowded base vertex
+            // gets twice its edges; chords joining loop vertices are split. Then search again.
+            // The second failure takes the whole remedy at once (the loops found so far are
+            // threaded through each step); later ones take one step each.
+            let mut partial = partial;
+            for &step in REFINE_STEPS[extra.min(REFINE_STEPS.len() - 1)] {
+                let before = local.mesh.clone();
+                refine_with(&mut local, &mut local_curves, |r| match step {
+                    Step::Band => r.split_edges(&band_of(&r.mesh, &partial, base)),
+                    Step::Chords => r.split_edges(&chords_of(&r.mesh, &partial)),
+                    Step::Valence => {
+                        let valence = r.mesh.outgoing(base).count();
+                        r.raise_valence(base, 2 * valence)
+                    }
+                })?;
+                match rethread(&before, &local.mesh, &partial) {
+                    Some(p) => partial = p,
+                    None => break,
+                }
+            }
+        }
+        if round < opts.max_subdivisions {
+            refine_with(&mut refined, &mut curves, |r| r.subdivide()?.raise_valence(base, 8 * g + 8))?;
+        }
+    }
+    Ok(None)
 }
 
 /// Applies one refinement to `r` and follows `curves` through it.
@@ -300,6 +314,10 @@ fn search(
 /// Dead ends the backtracking basis search may back out of before it gives up (genus3 seed 1
 /// needs about a dozen; each costs a few cuts and searches, see bench/NOTES.md).
 const MAX_DETOURS: usize = 30;
+
+/// Basis indices whose search may backtrack: basis 0 is the reference a job cannot do without;
+/// 1–3 gave 3holes seeds 2 and 3 their true class.
+const BACKTRACKED_BASES: usize = 4;
 
 /// The state shared by the levels of the backtracking search.
 struct Handles<'a> {

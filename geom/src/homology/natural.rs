@@ -3,8 +3,8 @@
 //! is least distorted (on the same shape, the true one).
 //!
 //! Every class the method can build from the first [`NaturalClassOptions::bases`] canonical
-//! bases on each mesh (up to [`NaturalClassOptions::more_bases`] when none of those is nearly
-//! isometric) and every rotation τ is composed (point location in two planar domains,
+//! bases on each mesh (doubled up to [`NaturalClassOptions::more_bases`] while none of those is
+//! nearly isometric) and every rotation τ is composed (point location in two planar domains,
 //! cheap next to relaxing a map) and measured by the L2 stretch of its chords both ways, before
 //! any relaxation: a wrong class wraps one handle's loops around another's and stretches by
 //! factors, not percent. Classes are told apart by the induced map on H1 read in the reference
@@ -22,16 +22,20 @@ use crate::progress::{Progress, Stage};
 pub struct NaturalClassOptions {
     /// Canonical bases tried on each mesh first (0 = shortest loops first).
     pub bases: usize,
-    /// Bases tried on each mesh when none of the first gives a class stretched by at most
-    /// `near`: genus 2 and more has classes the first bases and the polygon's rotations do not
-    /// reach (a turn inside one handle).
+    /// Bases tried on each mesh at most: while no class is stretched by at most `near`, the
+    /// bases tried are doubled (2, 4, 8). Genus 2 and more has classes the first bases and the
+    /// polygon's rotations do not reach (a turn inside one handle); on same-shape genus-2
+    /// cases the true class came from bases 4–5 on one mesh (bench/NOTES.md).
     pub more_bases: usize,
+    /// `more_bases` from genus 3 on, where a basis through a crowded anchor can take tens of
+    /// seconds to build (genus3 seed 1: 175 s with four bases, over 10 minutes with eight).
+    pub more_bases_genus3: usize,
     pub near: f64,
 }
 
 impl Default for NaturalClassOptions {
     fn default() -> Self {
-        Self { bases: 2, more_bases: 4, near: 1.10 }
+        Self { bases: 2, more_bases: 8, more_bases_genus3: 4, near: 1.10 }
     }
 }
 
@@ -70,8 +74,21 @@ pub fn natural_classes(
     let mut search = Search { source, target, bases, anchors, s: Vec::new(), t: Vec::new(), frames: None };
     let mut found: Vec<ClassCandidate> = Vec::new();
     let mut composed = 0;
-    for round in [0..o.bases.max(1), o.bases.max(1)..o.more_bases] {
+    let most = if crate::topology::summary(source).genus >= 3 { o.more_bases_genus3 } else { o.more_bases };
+    let mut rounds: Vec<std::ops::Range<usize>> = Vec::new();
+    let mut end = o.bases.max(1);
+    rounds.push(0..end);
+    while end < most {
+        let next = (2 * end).min(most);
+        rounds.push(end..next);
+        end = next;
+    }
+    for round in rounds {
         if round.start > 0 && found.first().is_some_and(|c| c.stretch <= o.near) {
+            break;
+        }
+        // A mesh whose bases ran out (an index that cannot be built) adds none.
+        if round.start > search.s.len().max(search.t.len()) {
             break;
         }
         let first = round.start;

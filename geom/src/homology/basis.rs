@@ -311,8 +311,8 @@ fn search(
     Ok(found.ok_or_else(|| h.partial.unwrap_or_default()))
 }
 
-/// Dead ends the backtracking basis search may back out of before it gives up (genus3 seed 1
-/// needs about a dozen; each costs a few cuts and searches, see bench/NOTES.md).
+/// Dead ends the backtracking basis search may back out of before it gives up (each costs a
+/// cut and a search or two; genus3 through vertex 6555 needs this pass, see bench/NOTES.md).
 const MAX_DETOURS: usize = 30;
 
 /// Basis indices whose search may backtrack: basis 0 is the reference a job cannot do without;

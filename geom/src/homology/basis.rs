@@ -306,7 +306,7 @@ fn search(
     max_detours: usize,
 ) -> Result<std::result::Result<Loops, Loops>> {
     let s = CutMesh { mesh: mesh.clone(), orig: (0..mesh.n_vertices()).map(VertexId::from_idx).collect() };
-    let mut h = Handles { blocked, base, g, first, max_detours, detours: 0, partial: None };
+    let mut h = HandleSearch { blocked, base, g, first, max_detours, detours: 0, partial: None };
     let found = h.descend(0, s, blocked.to_vec(), vec![base], Vec::with_capacity(2 * g))?;
     Ok(found.ok_or_else(|| h.partial.unwrap_or_default()))
 }
@@ -320,7 +320,7 @@ const MAX_DETOURS: usize = 30;
 const BACKTRACKED_BASES: usize = 4;
 
 /// The state shared by the levels of the backtracking search.
-struct Handles<'a> {
+struct HandleSearch<'a> {
     blocked: &'a [bool],
     base: VertexId,
     g: usize,
@@ -331,7 +331,7 @@ struct Handles<'a> {
     partial: Option<Loops>,
 }
 
-impl Handles<'_> {
+impl HandleSearch<'_> {
     /// Cuts handles `handle..g` from `s`, whose earlier loops are `loops`; `None` at a dead end
     /// (recorded) or when the detour budget is spent.
     fn descend(

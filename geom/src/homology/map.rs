@@ -4,10 +4,10 @@
 //! The homotopy class is chosen by the basis index on each mesh and by τ; the induced map on
 //! H1 is reported as an integer matrix computed from intersection numbers.
 
-use super::basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis};
+use super::basis::CanonicalBasisResult;
 use super::compose::{Planar, locate_all, warp_interior};
-use super::domain::{FundamentalDomainResult, fundamental_domain};
-use super::flat::{FlatTorusResult, flat_torus, locate_all_periodic};
+use super::flat::locate_all_periodic;
+use super::sides::{SideDomain, Sides};
 use crate::error::{Error, InputError, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
@@ -26,28 +26,6 @@ pub struct HomologyMapOptions {
     pub max_subdivisions: Option<usize>,
     /// Stretch-minimizing reweighting rounds of each domain map.
     pub stretch_iterations: usize,
-}
-
-/// One side's basis and domain.
-#[derive(Debug, Clone)]
-pub struct SideDomain {
-    pub basis: CanonicalBasisResult,
-    pub domain: FundamentalDomainResult,
-    /// Genus 1: the flat torus, when its embedding is bijective.
-    pub flat: Option<FlatTorusResult>,
-}
-
-impl SideDomain {
-    /// The disk and its planar positions, for composing maps.
-    pub fn planar(&self) -> Planar<'_> {
-        Planar { disk: &self.basis.disk, uv: &self.domain.uv, refined: Some(&self.basis.refined) }
-    }
-
-    /// The disk on its flat torus, when it has one.
-    pub fn flat_planar(&self) -> Option<Planar<'_>> {
-        let f = self.flat.as_ref()?;
-        Some(Planar { disk: &self.basis.disk, uv: &f.uv, refined: Some(&self.basis.refined) })
-    }
 }
 
 /// Maps both ways and what produced them.
@@ -73,34 +51,6 @@ pub fn rotation_count(genus: usize) -> usize {
     if genus == 1 { 4 } else { genus }
 }
 
-/// Basis and domain of one mesh through `base`.
-///
-/// # Errors
-/// As [`canonical_basis`] and [`fundamental_domain`].
-pub fn side_domain(
-    mesh: &Mesh,
-    base: VertexId,
-    index: usize,
-    max_subdivisions: Option<usize>,
-    stretch_iterations: usize,
-    min_attempt: usize,
-) -> Result<SideDomain> {
-    let mut o = CanonicalBasisOptions { basis_index: index, min_attempt, ..Default::default() };
-    if let Some(m) = max_subdivisions {
-        o.max_subdivisions = m;
-    }
-    let basis = canonical_basis(mesh, base, &o)?;
-    let domain = fundamental_domain(&basis, stretch_iterations)?;
-    // Genus 1: maps go through the flat torus; the square stays for the meta-mesh overlay, and
-    // takes over should the flat embedding not be bijective.
-    let flat = if basis.genus() == 1 {
-        Some(flat_torus(&basis, &domain.uv)?).filter(|f| f.injectivity.is_injective())
-    } else {
-        None
-    };
-    Ok(SideDomain { basis, domain, flat })
-}
-
 /// Maps `source` and `target` through canonical bases at `bases = (source vertex, target vertex)`.
 ///
 /// # Errors
@@ -112,17 +62,29 @@ pub fn homology_map(
     anchors: &[(VertexId, VertexId)],
     opts: &HomologyMapOptions,
 ) -> Result<HomologyMapResult> {
-    let side = |m: &Mesh, b: VertexId, k: usize, min: usize| {
-        side_domain(m, b, opts.basis[k], opts.max_subdivisions, opts.stretch_iterations, min)
-    };
-    let (s, t) = std::thread::scope(|sc| {
-        let h = sc.spawn(|| side(target, bases.1, 1, 0));
-        let s = side(source, bases.0, 0, 0);
-        (s, h.join())
+    let s = Sides::new(source, bases.0, opts.max_subdivisions, opts.stretch_iterations);
+    let t = Sides::new(target, bases.1, opts.max_subdivisions, opts.stretch_iterations);
+    class_map(&s, &t, opts.basis, opts.rotation, anchors)
+}
+
+/// [`homology_map`] of basis pair `basis` and rotation `rotation` from sides kept per job.
+///
+/// # Errors
+/// As [`homology_map`].
+pub fn class_map(
+    s: &Sides<'_>,
+    t: &Sides<'_>,
+    basis: [usize; 2],
+    rotation: usize,
+    anchors: &[(VertexId, VertexId)],
+) -> Result<HomologyMapResult> {
+    let (a, b) = std::thread::scope(|sc| {
+        let h = sc.spawn(|| t.get(basis[1], 0));
+        (s.get(basis[0], 0), h.join())
     });
-    let (s, t) = (s?, t.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??);
-    let (s, t) = aligned((s, t), &mut |min| side(source, bases.0, 0, min), &mut |min| side(target, bases.1, 1, min))?;
-    map_between(source, target, s, t, opts.rotation, anchors, false)
+    let (a, b) = (a?, b.map_err(|_| crate::Error::Internal("target basis thread panicked".into()))??);
+    let (a, b) = aligned((a, b), &mut |min| s.get(basis[0], min), &mut |min| t.get(basis[1], min))?;
+    map_between(s.mesh(), t.mesh(), a, b, rotation, anchors, false)
 }
 
 /// Both meshes refined alike: the side found at an earlier attempt is searched again up to the

@@ -12,6 +12,7 @@
 //! - [`classes`]: integer classes of basis loops; H1 in reference bases.
 //! - [`domain`]: the cut disk on the regular 4g-gon.
 //! - [`flat`]: a genus-1 mesh on its flat torus (periodic Tutte embedding).
+//! - [`sides`]: one mesh's basis, fundamental domain and flat torus, built once per job.
 //! - [`map`]: maps both ways through the two domains, rotation τ, induced map on H1.
 //! - [`matching`]: an explicit curve matching (`a1 -> b1`, …) realized by basis and rotation.
 //! - [`natural`]: the classes reachable by bases and rotations, least stretched first.
@@ -43,6 +44,7 @@ pub mod natural;
 pub mod overlay;
 pub mod prune;
 pub mod search;
+pub mod sides;
 pub mod word;
 
 pub use basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis};

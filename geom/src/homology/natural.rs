@@ -11,10 +11,11 @@
 //! bases ([`super::classes`]); the least stretched realization of each class stands for it.
 //! The pipeline relaxes candidates in this order and keeps the best relaxed one.
 
-use super::map::{SideDomain, aligned, chord_l2, map_between, rotation_count, side_domain};
+use super::map::{aligned, chord_l2, map_between, rotation_count};
 use super::matching::{Frame, reference_h1};
+use super::sides::Sides;
 use crate::error::{Error, InputError, Result};
-use crate::mesh::{Mesh, VertexId};
+use crate::mesh::VertexId;
 use crate::progress::{Progress, Stage};
 
 /// Options for [`natural_classes`].
@@ -57,21 +58,22 @@ pub struct NaturalClassResult {
     pub composed: usize,
 }
 
-/// The classes reachable from the first `o.bases` bases on each mesh through `bases` (the
-/// first anchor pair), `anchors` (the others) warped in as [`map_between`] does.
+/// The classes reachable from the first `o.bases` bases of `s` and `t` (each mesh's sides
+/// through the first anchor pair), `anchors` (the others) warped in as [`map_between`] does.
+/// The sides built stay in `s` and `t` for the relaxation that follows.
 ///
 /// # Errors
-/// As [`side_domain`] for basis 0 (later bases that cannot be built are skipped);
-/// `Cancelled`.
+/// As [`super::sides::side_domain`] for basis 0 (later bases that cannot be built are
+/// skipped); `Cancelled`.
 pub fn natural_classes(
-    source: &Mesh,
-    target: &Mesh,
-    bases: (VertexId, VertexId),
+    s: &Sides<'_>,
+    t: &Sides<'_>,
     anchors: &[(VertexId, VertexId)],
     o: &NaturalClassOptions,
     progress: &mut dyn Progress,
 ) -> Result<NaturalClassResult> {
-    let mut search = Search { source, target, bases, anchors, s: Vec::new(), t: Vec::new(), frames: None };
+    let source = s.mesh();
+    let mut search = Search { s, t, anchors, have: [0, 0], genus: 0, frames: None };
     let mut found: Vec<ClassCandidate> = Vec::new();
     let mut composed = 0;
     let most = if crate::topology::summary(source).genus >= 3 { o.more_bases_genus3 } else { o.more_bases };
@@ -88,16 +90,15 @@ pub fn natural_classes(
             break;
         }
         // A mesh whose bases ran out (an index that cannot be built) adds none.
-        if round.start > search.s.len().max(search.t.len()) {
+        if round.start > search.have[0].max(search.have[1]) {
             break;
         }
         let first = round.start;
         search.add_bases(round)?;
-        let g = search.s[0].basis.genus();
-        let pairs: Vec<(usize, usize)> = (0..search.s.len())
-            .flat_map(|ks| (0..search.t.len()).map(move |kt| (ks, kt)))
-            .filter(|&(ks, kt)| ks.max(kt) >= first)
-            .collect();
+        let g = search.genus;
+        let [ns, nt] = search.have;
+        let pairs: Vec<(usize, usize)> =
+            (0..ns).flat_map(|ks| (0..nt).map(move |kt| (ks, kt))).filter(|&(ks, kt)| ks.max(kt) >= first).collect();
         // Two basis pairs at a time, one on a side thread.
         for (i, two) in pairs.chunks(2).enumerate() {
             progress.check()?;
@@ -126,60 +127,58 @@ pub fn natural_classes(
     Ok(NaturalClassResult { candidates: found, composed })
 }
 
-/// The bases built so far on each mesh and the reference frames.
-struct Search<'a> {
-    source: &'a Mesh,
-    target: &'a Mesh,
-    bases: (VertexId, VertexId),
-    anchors: &'a [(VertexId, VertexId)],
-    s: Vec<SideDomain>,
-    t: Vec<SideDomain>,
+/// Both meshes' sides, how many bases each has so far, and the reference frames.
+struct Search<'s, 'm> {
+    s: &'s Sides<'m>,
+    t: &'s Sides<'m>,
+    anchors: &'s [(VertexId, VertexId)],
+    /// Bases built on the source and on the target (indices `0..have`).
+    have: [usize; 2],
+    genus: usize,
     frames: Option<(Frame, Frame)>,
 }
 
-impl Search<'_> {
+impl Search<'_, '_> {
     /// Bases `ks` on each mesh (both on two threads); a basis index that cannot be built ends
     /// that mesh's list, except basis 0, whose failure is the job's.
     fn add_bases(&mut self, ks: std::ops::Range<usize>) -> Result<()> {
-        let more = |m: &Mesh, b: VertexId, have: usize| -> Result<Vec<SideDomain>> {
-            let mut out = Vec::new();
+        let more = |side: &Sides<'_>, have: usize| -> Result<usize> {
+            let mut n = have;
             for k in ks.clone() {
-                if k != have + out.len() {
+                if k != n {
                     break;
                 }
-                match side_domain(m, b, k, None, 0, 0) {
-                    Ok(sd) => out.push(sd),
+                match side.get(k, 0) {
+                    Ok(_) => n += 1,
                     Err(e) if k == 0 => return Err(e),
                     Err(_) => break,
                 }
             }
-            Ok(out)
+            Ok(n)
         };
         let (a, b) = std::thread::scope(|sc| {
-            let h = sc.spawn(|| more(self.target, self.bases.1, self.t.len()));
-            (more(self.source, self.bases.0, self.s.len()), h.join())
+            let h = sc.spawn(|| more(self.t, self.have[1]));
+            (more(self.s, self.have[0]), h.join())
         });
-        self.s.extend(a?);
-        self.t.extend(b.map_err(|_| Error::Internal("target basis thread panicked".into()))??);
-        let (g, gt) = (self.s[0].basis.genus(), self.t[0].basis.genus());
-        if g != gt {
-            return Err(InputError::TopologyMismatch(format!("source genus {g}, target genus {gt}")).into());
-        }
+        self.have = [a?, b.map_err(|_| Error::Internal("target basis thread panicked".into()))??];
         if self.frames.is_none() {
-            self.frames =
-                Some((Frame::new(self.source, &self.s[0].basis)?, Frame::new(self.target, &self.t[0].basis)?));
+            let (s0, t0) = (self.s.get(0, 0)?, self.t.get(0, 0)?);
+            let (g, gt) = (s0.basis.genus(), t0.basis.genus());
+            if g != gt {
+                return Err(InputError::TopologyMismatch(format!("source genus {g}, target genus {gt}")).into());
+            }
+            self.genus = g;
+            self.frames = Some((Frame::new(self.s.mesh(), &s0.basis)?, Frame::new(self.t.mesh(), &t0.basis)?));
         }
         Ok(())
     }
 
     /// Every rotation of basis pair (`ks`, `kt`), composed and measured.
     fn pair(&self, ks: usize, kt: usize, g: usize) -> Result<Vec<ClassCandidate>> {
-        let (source, target, bases) = (self.source, self.target, self.bases);
-        let (sa, ta) = aligned(
-            (self.s[ks].clone(), self.t[kt].clone()),
-            &mut |min| side_domain(source, bases.0, ks, None, 0, min),
-            &mut |min| side_domain(target, bases.1, kt, None, 0, min),
-        )?;
+        let (source, target) = (self.s.mesh(), self.t.mesh());
+        let (sa, ta) = aligned((self.s.get(ks, 0)?, self.t.get(kt, 0)?), &mut |min| self.s.get(ks, min), &mut |min| {
+            self.t.get(kt, min)
+        })?;
         let (fs, ft) = self.frames.as_ref().ok_or_else(|| Error::Internal("natural: no frames".into()))?;
         (0..rotation_count(g))
             .map(|rotation| {

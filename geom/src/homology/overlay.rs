@@ -8,7 +8,7 @@
 //! vertex they copy. The result has one face list and two vertex positions per meta-vertex:
 //! on the source (barycentric in the source triangle it lies in) and on the target.
 
-use super::map::SideDomain;
+use super::sides::SideDomain;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, P3, VertexId};
 use crate::param::Uv;

@@ -10,10 +10,10 @@ use super::homology_class::{CandidateReport, ClassPlan, Relaxed, candidate_repor
 use super::spec::HomologySpec;
 use super::spec::RelaxOptions;
 use crate::error::{Error, Result};
-use crate::homology::map::SideDomain;
-use crate::homology::map::map_between;
+use crate::homology::HomologyMapResult;
+use crate::homology::map::{class_map, map_between};
 use crate::homology::matching::{reference_frame, reference_h1};
-use crate::homology::{HomologyMapOptions, HomologyMapResult, homology_map};
+use crate::homology::sides::{SideDomain, Sides};
 use crate::mesh::{Mesh, VertexId};
 use crate::progress::{Progress, Stage};
 use serde::Serialize;
@@ -78,14 +78,17 @@ pub fn run(
     let o = &spec.options;
     clock.lap("setup");
     progress.report(Stage::Basis, 0.0);
-    let plan = ClassPlan::new(o.class_choice(), source, target, &pairs, progress)?;
+    // Bases and domains are built once and kept: the natural search composes every pair of
+    // them, and the relaxation rebuilds the classes it chose from the same ones.
+    let sides = (Sides::new(source, pairs[0].0, None, 0), Sides::new(target, pairs[0].1, None, 0));
+    let plan = ClassPlan::new(o.class_choice(), (&sides.0, &sides.1), &pairs, progress)?;
     clock.lap("classes");
     // Each class in the plan is built and relaxed in turn: the close ones all, the others while
     // none is fold-free; the least folded, then least stretched, stands.
     let mut relaxed: Vec<Relaxed> = Vec::new();
     let mut best: Option<(usize, HomologyMapResult, FinishedPair)> = None;
     for (i, &(basis, rotation)) in plan.tries.iter().enumerate() {
-        let (r, f) = relax_class(source, target, &pairs, basis, rotation, &o.relax(), progress)?;
+        let (r, f) = relax_class((&sides.0, &sides.1), &pairs, basis, rotation, &o.relax(), progress)?;
         let out = Relaxed::of(&f);
         tracing::debug!(?basis, rotation, flips = ?out.flips, l2 = ?out.l2_stretch, "homology class relaxed");
         relaxed.push(out);
@@ -180,27 +183,22 @@ pub fn run(
 /// stands (between different shapes the flat tori can differ more than the squares' interiors
 /// do).
 fn relax_class(
-    source: &Mesh,
-    target: &Mesh,
+    (s, t): (&Sides<'_>, &Sides<'_>),
     pairs: &[(VertexId, VertexId)],
     basis: [usize; 2],
     rotation: usize,
     relax: &RelaxOptions,
     progress: &mut dyn Progress,
 ) -> Result<(HomologyMapResult, FinishedPair)> {
-    let hopts = HomologyMapOptions {
-        basis,
-        rotation,
-        max_subdivisions: None,
-        // Reweighting each domain on its own lowers each map's stretch but raised the
-        // composed map's folds on every different-shape pair measured (bench/NOTES.md).
-        stretch_iterations: 0,
-    };
+    // The sides carry no stretch reweighting: reweighting each domain on its own lowers each
+    // map's stretch but raised the composed map's folds on every different-shape pair
+    // measured (bench/NOTES.md).
+    let (source, target) = (s.mesh(), t.mesh());
     let anchors = &pairs[1..];
     let finish = |r: &HomologyMapResult, progress: &mut dyn Progress| {
         finish_pair(source, target, (&r.source_to_target, &r.target_to_source), pairs, (&[], &[]), relax, progress)
     };
-    let r = homology_map(source, target, pairs[0], anchors, &hopts)?;
+    let r = class_map(s, t, basis, rotation, anchors)?;
     progress.check()?;
     let f = finish(&r, progress)?;
     if !r.flat || Relaxed::of(&f).flips == [0, 0] {

@@ -6,7 +6,8 @@ use super::spec::ClassChoice;
 use crate::error::Result;
 use crate::homology::matching::{MatchingOptions, find_matching, parse_matching};
 use crate::homology::natural::{ClassCandidate, NaturalClassOptions, natural_classes};
-use crate::mesh::{Mesh, VertexId};
+use crate::homology::sides::Sides;
+use crate::mesh::VertexId;
 use crate::progress::Progress;
 use serde::Serialize;
 
@@ -34,17 +35,18 @@ pub struct ClassPlan {
 }
 
 impl ClassPlan {
-    /// Resolves `choice` on the meshes through the base pair `pairs[0]`.
+    /// Resolves `choice` on the meshes through the base pair `pairs[0]`; the natural search
+    /// builds its bases in `sides` (the source's and the target's through that pair).
     ///
     /// # Errors
     /// An unparsable or unreachable matching; what the natural search reports.
     pub fn new(
         choice: ClassChoice<'_>,
-        source: &Mesh,
-        target: &Mesh,
+        sides: (&Sides<'_>, &Sides<'_>),
         pairs: &[(VertexId, VertexId)],
         progress: &mut dyn Progress,
     ) -> Result<ClassPlan> {
+        let (source, target) = (sides.0.mesh(), sides.1.mesh());
         let one = |basis, rotation, want| ClassPlan {
             tries: vec![(basis, rotation)],
             compare: 1,
@@ -60,8 +62,7 @@ impl ClassPlan {
                 Ok(one(found.basis, found.rotation, Some(w)))
             }
             ClassChoice::Natural => {
-                let n =
-                    natural_classes(source, target, pairs[0], &pairs[1..], &NaturalClassOptions::default(), progress)?;
+                let n = natural_classes(sides.0, sides.1, &pairs[1..], &NaturalClassOptions::default(), progress)?;
                 let tries: Vec<_> = n.candidates.iter().take(MAX_RELAXED).map(|c| (c.basis, c.rotation)).collect();
                 let least = n.candidates.first().map_or(f64::INFINITY, |c| c.stretch);
                 let compare =

@@ -13,6 +13,15 @@ const BASE: u64 = 320 << 20;
 /// Bytes per mesh vertex of a pair job at the default options (both meshes, their layouts,
 /// charts, factorizations and the maps both ways), per input vertex.
 const PER_VERTEX: u64 = 6 << 10;
+/// A `homology` job's extra per handle: the canonical-basis searches (with backtracking from
+/// genus 2 on) and the side domains the natural-class search keeps (`homology::sides`). Fitted
+/// with [`HOMOLOGY_PER_VERTEX_PER_GENUS`] to measured peaks: 3holes (genus 3, 7.2k vertices in
+/// all) 820 MB, genus3 (13.3k) 1.08 GB, cup (genus 2, 20k) 0.50 GB, kitten (genus 1, 20k)
+/// 0.13 GB (`bench/NOTES.md`).
+const HOMOLOGY_PER_GENUS: u64 = 160 << 20;
+/// A `homology` job's extra bytes per input vertex and handle (refined copies of each mesh in
+/// the bases and domains kept).
+const HOMOLOGY_PER_VERTEX_PER_GENUS: u64 = 12 << 10;
 /// Bytes per layout edge node (positions, graph adjacency, search state).
 const PER_EDGE_NODE: u64 = 96;
 /// Bytes per metric sample (point, nearest face, distances), per direction.
@@ -38,9 +47,13 @@ impl JobSpec {
         };
         let bytes = match self {
             JobSpec::Voronoi(spec) | JobSpec::Greedy(spec) => pair(&spec.options.layout, spec.options.metric_samples),
-            // Cut meshes, subdivided bases and the maps: measured below a layout job's peak at
-            // the default layout options.
-            JobSpec::Homology(spec) => pair(&Default::default(), spec.options.metric_samples),
+            // Cut meshes, subdivided bases and the maps, plus what grows with the handles.
+            JobSpec::Homology(spec) => {
+                let genus = summaries.iter().map(|s| s.genus.max(0) as u64).max().unwrap_or(0);
+                pair(&Default::default(), spec.options.metric_samples)
+                    .saturating_add(HOMOLOGY_PER_GENUS.saturating_mul(genus))
+                    .saturating_add(HOMOLOGY_PER_VERTEX_PER_GENUS.saturating_mul(genus).saturating_mul(vertices))
+            }
             JobSpec::Quad(spec) => {
                 let o = &spec.options;
                 let models = summaries.len() as u64;
@@ -61,5 +74,41 @@ impl JobSpec {
             }
         };
         BASE.saturating_add(bytes)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn closed(vertices: usize, genus: i64) -> Summary {
+        let faces = 2 * vertices + 4 * genus as usize - 4;
+        Summary {
+            vertices,
+            faces,
+            edges: 3 * faces / 2,
+            components: 1,
+            boundary_loops: 0,
+            euler_characteristic: 2 - 2 * genus,
+            genus,
+            manifold: true,
+            orientable: true,
+            bbox: [[0.0; 3], [1.0; 3]],
+            bbox_diagonal: 3f64.sqrt(),
+            area: 1.0,
+            input_vertices: None,
+        }
+    }
+
+    /// The homology estimate stays above the peaks measured on the shared meshes (resident
+    /// set of `surfmap map`, default job with one anchor; bench/NOTES.md).
+    #[test]
+    fn homology_estimates_cover_the_measured_peaks() {
+        let job = JobSpec::from_json(br#"{"method": "homology", "anchors": [[0, 0]]}"#).expect("a homology job");
+        let mib = |v: usize, g: i64| job.memory_estimate(&[closed(v, g), closed(v, g)]) >> 20;
+        for (v, g, peak_mib) in [(3596, 3, 801), (6652, 3, 1052), (10000, 2, 489), (10000, 1, 127)] {
+            assert!(mib(v, g) >= peak_mib, "{v} vertices, genus {g}: {} MiB against {peak_mib}", mib(v, g));
+        }
+        assert!(mib(5000, 3) > mib(5000, 1));
     }
 }

@@ -12,7 +12,7 @@ use super::basis::{CanonicalBasisOptions, CanonicalBasisResult, canonical_basis}
 use super::compose::Planar;
 use super::domain::{FundamentalDomainResult, fundamental_domain};
 use super::flat::{FlatTorusResult, flat_torus};
-use crate::error::Result;
+use crate::error::{Error, InputError, Result};
 use crate::mesh::{Mesh, VertexId};
 use std::sync::Mutex;
 
@@ -78,6 +78,10 @@ pub struct Sides<'a> {
     stretch_iterations: usize,
     /// (basis index, first attempt asked for, the side found).
     kept: Mutex<Vec<(usize, usize, SideDomain)>>,
+    /// (basis index, first attempt asked for, why no basis was found from there): no later
+    /// first attempt finds one either, and the failing search is the costliest (both passes
+    /// over every refinement).
+    missing: Mutex<Vec<(usize, usize, InputError)>>,
     built: std::sync::atomic::AtomicUsize,
 }
 
@@ -90,6 +94,7 @@ impl<'a> Sides<'a> {
             max_subdivisions,
             stretch_iterations,
             kept: Mutex::new(Vec::new()),
+            missing: Mutex::new(Vec::new()),
             built: Default::default(),
         }
     }
@@ -110,19 +115,43 @@ impl<'a> Sides<'a> {
     /// Basis `index` first found at an attempt ≥ `min_attempt`, with its domains.
     ///
     /// # Errors
-    /// As [`side_domain`] (a failure is not kept: it is built again when asked again).
+    /// As [`side_domain`]. An input error (no basis from that attempt on) is kept and answers
+    /// every later first attempt; other errors are not kept.
     pub fn get(&self, index: usize, min_attempt: usize) -> Result<SideDomain> {
         if let Some(sd) = self.lookup(index, min_attempt) {
             return Ok(sd);
         }
+        if let Some(e) = self.known_missing(index, min_attempt) {
+            return Err(e.into());
+        }
         self.built.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let sd = side_domain(self.mesh, self.base, index, self.max_subdivisions, self.stretch_iterations, min_attempt)?;
+        let sd =
+            match side_domain(self.mesh, self.base, index, self.max_subdivisions, self.stretch_iterations, min_attempt)
+            {
+                Ok(sd) => sd,
+                Err(Error::Input(e)) => {
+                    self.missing.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push((
+                        index,
+                        min_attempt,
+                        e.clone(),
+                    ));
+                    return Err(e.into());
+                }
+                Err(e) => return Err(e),
+            };
         let mut kept = self.kept.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         // Another thread may have built the same side meanwhile.
         if kept.len() < MAX_KEPT && !kept.iter().any(|e| Self::answers(e, index, min_attempt)) {
             kept.push((index, min_attempt, sd.clone()));
         }
         Ok(sd)
+    }
+
+    /// Why basis `index` has no basis from `min_attempt` on, when a search from that attempt
+    /// or an earlier one already failed.
+    fn known_missing(&self, index: usize, min_attempt: usize) -> Option<InputError> {
+        let missing = self.missing.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        missing.iter().find(|(k, m, _)| *k == index && *m <= min_attempt).map(|(.., e)| e.clone())
     }
 
     fn lookup(&self, index: usize, min_attempt: usize) -> Option<SideDomain> {
@@ -159,5 +188,20 @@ mod tests {
         let other = sides.get(1, 0).expect("a second basis");
         assert_eq!(sides.built(), 3);
         assert_ne!(other.basis.loops, first.basis.loops, "basis 1 is another basis");
+    }
+
+    /// A basis that cannot be built from an attempt on is not searched again from that attempt
+    /// or a later one; the error is the same.
+    #[test]
+    fn a_missing_basis_is_searched_once() {
+        let torus = shapes::torus(24, 12, 1.0, 0.35);
+        let sides = Sides::new(&torus, VertexId(0), Some(0), 0);
+        let beyond = 10 * crate::homology::basis::ATTEMPTS_PER_ROUND;
+        let e1 = sides.get(0, beyond).expect_err("no attempt that late without subdivisions").to_string();
+        assert_eq!(sides.built(), 1);
+        let e2 = sides.get(0, beyond + 1).expect_err("later still").to_string();
+        assert_eq!((sides.built(), e2), (1, e1), "answered by the kept failure");
+        sides.get(0, 0).expect("an earlier attempt finds the basis");
+        assert_eq!(sides.built(), 2);
     }
 }

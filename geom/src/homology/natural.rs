@@ -29,7 +29,7 @@ pub struct NaturalClassOptions {
     /// cases the true class came from bases 4–5 on one mesh (bench/NOTES.md).
     pub more_bases: usize,
     /// `more_bases` from genus 3 on, where a basis through a crowded anchor can take tens of
-    /// seconds to build (genus3 seed 1: 138 s with four bases; over 10 minutes with eight, measured
+    /// seconds to build (genus3 seed 1: 117 s with four bases; over 10 minutes with eight, measured
     /// before the sides were kept, `homology::sides`).
     pub more_bases_genus3: usize,
     pub near: f64,

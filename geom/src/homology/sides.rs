@@ -103,10 +103,6 @@ impl<'a> Sides<'a> {
         self.mesh
     }
 
-    pub fn base(&self) -> VertexId {
-        self.base
-    }
-
     /// Side domains built so far (requests answered by a kept one are not counted).
     pub fn built(&self) -> usize {
         self.built.load(std::sync::atomic::Ordering::Relaxed)
@@ -130,16 +126,12 @@ impl<'a> Sides<'a> {
             {
                 Ok(sd) => sd,
                 Err(Error::Input(e)) => {
-                    self.missing.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push((
-                        index,
-                        min_attempt,
-                        e.clone(),
-                    ));
+                    lock(&self.missing).push((index, min_attempt, e.clone()));
                     return Err(e.into());
                 }
                 Err(e) => return Err(e),
             };
-        let mut kept = self.kept.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut kept = lock(&self.kept);
         // Another thread may have built the same side meanwhile.
         if kept.len() < MAX_KEPT && !kept.iter().any(|e| Self::answers(e, index, min_attempt)) {
             kept.push((index, min_attempt, sd.clone()));
@@ -150,12 +142,12 @@ impl<'a> Sides<'a> {
     /// Why basis `index` has no basis from `min_attempt` on, when a search from that attempt
     /// or an earlier one already failed.
     fn known_missing(&self, index: usize, min_attempt: usize) -> Option<InputError> {
-        let missing = self.missing.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let missing = lock(&self.missing);
         missing.iter().find(|(k, m, _)| *k == index && *m <= min_attempt).map(|(.., e)| e.clone())
     }
 
     fn lookup(&self, index: usize, min_attempt: usize) -> Option<SideDomain> {
-        let kept = self.kept.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let kept = lock(&self.kept);
         kept.iter().find(|e| Self::answers(e, index, min_attempt)).map(|(.., s)| s.clone())
     }
 
@@ -163,6 +155,12 @@ impl<'a> Sides<'a> {
     fn answers((k, m, s): &(usize, usize, SideDomain), index: usize, min_attempt: usize) -> bool {
         *k == index && (*m..=s.basis.attempt).contains(&min_attempt)
     }
+}
+
+/// The data behind `m`, also after a thread panicked holding it: entries are pushed whole, so
+/// a poisoned list is still a consistent one.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 #[cfg(test)]

@@ -27,6 +27,7 @@ pub mod planar;
 pub mod progress;
 pub mod quad;
 pub mod simplify;
+pub mod sphere;
 pub mod tol;
 pub mod topology;
 

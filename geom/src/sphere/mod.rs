@@ -1,0 +1,26 @@
+//! Genus-0 surfaces on the unit sphere, bijectively at every step (issue 50).
+//!
+//! - [`orient`]: the exact orientation of spherical triangles and the check that a placement is
+//!   a bijective spherical triangulation (every triangle positive, degree 1).
+//! - [`tutte`]: a known-bijective start, Tutte's embedding through the gnomonic plane.
+//! - [`max_step`]: the longest step along a direction before a triangle inverts (a cubic).
+//! - [`barrier`]: the orientation barrier of triangles too large for their chord to see it.
+//! - [`newton`]: injective projected Newton for points on the sphere, any image energy.
+//! - [`kernel`]: where a vertex goes inside its ring when a collapse is undone.
+//! - [`multires`]: coarse to fine over a quadric decimation's collapses.
+//! - [`embed`]: a mesh's low-distortion bijective sphere embedding.
+//!
+//! Imports run downward: `embed` → `multires` → `kernel`, `newton` → `barrier`, `max_step`, `orient`;
+//! `tutte` → `linalg`.
+
+pub mod barrier;
+pub mod embed;
+pub mod kernel;
+pub mod max_step;
+pub mod multires;
+pub mod newton;
+pub mod orient;
+pub mod tutte;
+
+pub use embed::{SphereEmbedOptions, SphereEmbedReport, SphereEmbedding, embed_sphere};
+pub use newton::{OnSphere, SphereImage, SphereNewton, SphereNewtonOptions, SphereNewtonResult};

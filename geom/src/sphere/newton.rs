@@ -1,0 +1,344 @@
+//! Injective projected Newton for vertices on the unit sphere.
+//!
+//! The unknowns are a tangent step per free vertex in a frame of its own; a vertex at `p` moves
+//! to `normalize(p + t₁ b₁ + t₂ b₂)` (the retraction of Schmidt, Pieper & Kobbelt 2023). Each
+//! vertex's sphere point has an *image* in space ([`SphereImage`]): the point itself for a
+//! sphere embedding, the point carried onto a target surface for a map between surfaces. The
+//! energy is the area-weighted symmetric Dirichlet energy of every triangle's image (its chord
+//! triangle, laid out in its own plane) against the triangle's rest shape
+//! ([`crate::optim::sym_dirichlet`]); it grows without bound as an image degenerates. A
+//! triangle too large for its chord to see its inversion also pays [`super::barrier`].
+//!
+//! Each iteration assembles the gradient and the per-triangle PSD-projected Hessians into one
+//! sparse system whose pattern never changes ([`crate::optim::block_system`]: symbolic
+//! factorization once, numeric per iteration) and solves for the Newton direction. The line
+//! search starts at `step_fraction` of the first inversion on the sphere along the direction
+//! ([`super::max_step`], exact for the retraction) and halves until the energy drops enough
+//! (Armijo) **and** every triangle is positive under the exact predicate. So a start that is a
+//! bijective spherical triangulation stays one through every accepted step: no triangle changes
+//! sign on the continuous path, so the covering's degree stays 1.
+
+use super::barrier::barrier;
+use super::max_step::first_inversion;
+use super::orient::{all_positive, det};
+use crate::error::{Error, InputError, Result};
+use crate::mesh::{P3, V3};
+use crate::optim::RestTriangle;
+use crate::optim::block_system::BlockSystem;
+use crate::optim::sym_dirichlet::{IDENTITY, Mat2};
+use crate::progress::Progress;
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// A triangle's gradient and projected Hessian in its corners' tangent steps.
+type Block = ([f64; 6], [[f64; 6]; 6]);
+
+/// Where a vertex's sphere point lands in space, and how it moves.
+pub trait SphereImage: Sync {
+    /// The image of vertex `v` placed at `p`, with its derivatives along the tangent frame
+    /// `frame` at `p`; `None` where it has none.
+    fn image(&self, v: u32, p: &P3, frame: &[V3; 2]) -> Option<(P3, [V3; 2])>;
+}
+
+/// The sphere itself: the image of a point is the point (a sphere embedding's energy).
+pub struct OnSphere;
+
+impl SphereImage for OnSphere {
+    fn image(&self, _v: u32, p: &P3, frame: &[V3; 2]) -> Option<(P3, [V3; 2])> {
+        Some((*p, *frame))
+    }
+}
+
+/// Options for [`SphereNewton::minimize`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SphereNewtonOptions {
+    /// Iterations at most.
+    pub max_iterations: usize,
+    /// Stop when the Newton decrement (the drop a full step would give on the quadratic model)
+    /// is below this fraction of the energy.
+    pub tolerance: f64,
+    /// The first trial step as a fraction of the first inversion on the sphere.
+    pub step_fraction: f64,
+    /// No vertex moves farther than this (radians of tangent step) in one trial.
+    pub max_move: f64,
+}
+
+impl Default for SphereNewtonOptions {
+    fn default() -> Self {
+        Self { max_iterations: 200, tolerance: 1e-4, step_fraction: 0.8, max_move: 0.5 }
+    }
+}
+
+/// What [`SphereNewton::minimize`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SphereNewtonResult {
+    pub iterations: usize,
+    pub energy_before: f64,
+    pub energy_after: f64,
+    /// Trial steps refused (energy not lower enough or a triangle not positive).
+    pub backtracks: usize,
+    /// Whether it stopped on the tolerance or a zero step (not on the iteration limit).
+    pub converged: bool,
+}
+
+/// Triangles with rest shapes and fixed vertices, ready to optimize on the sphere. The
+/// symbolic factorization happens once, in [`SphereNewton::new`].
+pub struct SphereNewton {
+    triangles: Vec<[u32; 3]>,
+    rest: Vec<RestTriangle>,
+    fixed: Vec<bool>,
+    system: BlockSystem,
+}
+
+/// A unit tangent frame at `p` (right-handed with the outward normal).
+pub fn tangent_frame(p: &P3) -> [V3; 2] {
+    let n = p.coords;
+    let helper = if n.x.abs() < 0.6 { V3::x() } else { V3::y() };
+    let b1 = (helper - n * n.dot(&helper)).normalize();
+    [b1, n.cross(&b1)]
+}
+
+/// The chord triangle `x` in its own plane (`x0` at the origin, `x1` on the first axis), and
+/// the frame's two axes; `None` when degenerate.
+pub fn chord_layout(x: [P3; 3]) -> Option<([[f64; 2]; 3], [V3; 2])> {
+    let (e1, e2) = (x[1] - x[0], x[2] - x[0]);
+    let l1 = e1.norm();
+    let n = e1.cross(&e2);
+    let nn = n.norm();
+    if l1 <= 0.0 || nn <= 0.0 || !nn.is_finite() {
+        return None;
+    }
+    let u = e1 / l1;
+    let w = (n / nn).cross(&u);
+    Some(([[0.0, 0.0], [l1, 0.0], [e2.dot(&u), e2.dot(&w)]], [u, w]))
+}
+
+impl SphereNewton {
+    /// Prepares `triangles` over `n_vertices` with their rest shapes; `fixed` vertices never move.
+    ///
+    /// # Errors
+    /// `Invalid` for mismatched lengths or an out-of-range vertex; as [`BlockSystem::new`].
+    pub fn new(n_vertices: usize, triangles: Vec<[u32; 3]>, rest: Vec<RestTriangle>, fixed: &[u32]) -> Result<Self> {
+        if rest.len() != triangles.len() || triangles.iter().flatten().any(|&v| v as usize >= n_vertices) {
+            return Err(InputError::Invalid("triangles and rest shapes do not match the vertices".into()).into());
+        }
+        let mut is_fixed = vec![false; n_vertices];
+        for &v in fixed {
+            *is_fixed.get_mut(v as usize).ok_or_else(|| InputError::Invalid(format!("fixed vertex {v}")))? = true;
+        }
+        let mut next = 0u32;
+        let free_index: Vec<u32> = is_fixed
+            .iter()
+            .map(|&f| {
+                if f {
+                    u32::MAX
+                } else {
+                    next += 1;
+                    next - 1
+                }
+            })
+            .collect();
+        let system = BlockSystem::new(&free_index, &triangles)?;
+        Ok(Self { triangles, rest, fixed: is_fixed, system })
+    }
+
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// The energy at sphere points `s`; `None` when a triangle is not positive (in floating
+    /// point) or an image is degenerate.
+    pub fn energy<I: SphereImage>(&self, image: &I, s: &[P3]) -> Option<f64> {
+        let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
+        let images: Option<Vec<P3>> =
+            s.par_iter().enumerate().map(|(v, p)| image.image(v as u32, p, &frames[v]).map(|x| x.0)).collect();
+        let images = images?;
+        let e: f64 = (0..self.triangles.len())
+            .into_par_iter()
+            .map(|t| {
+                let tri = self.triangles[t];
+                let [a, b, c] = tri.map(|v| &s[v as usize]);
+                if det(a, b, c) <= 0.0 {
+                    return f64::INFINITY;
+                }
+                let guard = barrier(self.rest[t].area(), [a, b, c]).map_or(f64::INFINITY, |g| g.0);
+                chord_layout(tri.map(|v| images[v as usize]))
+                    .and_then(|(x, _)| self.rest[t].energy_in(x, &IDENTITY))
+                    .map_or(f64::INFINITY, |e| e + guard)
+            })
+            .sum();
+        e.is_finite().then_some(e)
+    }
+
+    /// Minimizes the energy from the bijective start `s`, in place; every accepted step keeps
+    /// every triangle positive under the exact predicate. Checks for cancellation every
+    /// iteration.
+    ///
+    /// # Errors
+    /// `Invalid` when `s` does not start with every triangle positive; `Numerical` when a
+    /// Newton system cannot be solved; `Cancelled`.
+    pub fn minimize<I: SphereImage>(
+        &self,
+        image: &I,
+        s: &mut Vec<P3>,
+        opts: &SphereNewtonOptions,
+        progress: &dyn Progress,
+    ) -> Result<SphereNewtonResult> {
+        let start = match self.energy(image, s) {
+            Some(e) if all_positive(s, &self.triangles) => e,
+            _ => return Err(InputError::Invalid("the start on the sphere is not injective".into()).into()),
+        };
+        let mut r = SphereNewtonResult {
+            iterations: 0,
+            energy_before: start,
+            energy_after: start,
+            backtracks: 0,
+            converged: false,
+        };
+        let mut energy = start;
+        for _ in 0..opts.max_iterations {
+            progress.check()?;
+            let (dir, slope) = self.direction(image, s)?;
+            if -0.5 * slope < opts.tolerance * energy {
+                r.converged = true;
+                break;
+            }
+            let Some((next, e, refused)) = self.line_search(image, s, &dir, slope, energy, opts) else {
+                r.converged = true;
+                break;
+            };
+            tracing::trace!(iteration = r.iterations, energy, e, refused, "sphere newton step");
+            r.iterations += 1;
+            r.backtracks += refused;
+            *s = next;
+            energy = e;
+        }
+        r.energy_after = energy;
+        Ok(r)
+    }
+
+    /// The Newton direction per vertex as a tangent vector (zero on fixed vertices), with the
+    /// gradient dotted into it.
+    fn direction<I: SphereImage>(&self, image: &I, s: &[P3]) -> Result<(Vec<V3>, f64)> {
+        let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
+        let images: Vec<(P3, [V3; 2])> = s
+            .par_iter()
+            .enumerate()
+            .map(|(v, p)| image.image(v as u32, p, &frames[v]))
+            .collect::<Option<_>>()
+            .ok_or_else(|| Error::Internal("a vertex without an image inside the optimization".into()))?;
+        let blocks: Vec<Option<Block>> = (0..self.triangles.len())
+            .into_par_iter()
+            .map(|t| {
+                let tri = self.triangles[t];
+                let (x, [u, w]) = chord_layout(tri.map(|v| images[v as usize].0))?;
+                let m: [Mat2; 3] = tri.map(|v| {
+                    let a = &images[v as usize].1;
+                    [[u.dot(&a[0]), u.dot(&a[1])], [w.dot(&a[0]), w.dot(&a[1])]]
+                });
+                let (_, mut g, mut h) = self.rest[t].derivatives_in(x, &IDENTITY, &m)?;
+                let (value, gb, k) = barrier(self.rest[t].area(), tri.map(|v| &s[v as usize]))?;
+                if value > 0.0 {
+                    let mut q = [0.0; 6];
+                    for (i, &v) in tri.iter().enumerate() {
+                        for j in 0..2 {
+                            q[2 * i + j] = frames[v as usize][j].dot(&gb[i]);
+                        }
+                    }
+                    for i in 0..6 {
+                        g[i] += q[i];
+                        for j in 0..6 {
+                            h[i][j] += k * q[i] * q[j];
+                        }
+                    }
+                }
+                Some((g, h))
+            })
+            .collect();
+        let n = self.system.len();
+        let mut grad = vec![0.0; n];
+        let mut values = self.system.zero_values();
+        for (t, b) in blocks.iter().enumerate() {
+            let (g, h) =
+                b.as_ref().ok_or_else(|| Error::Internal("a degenerate image inside the optimization".into()))?;
+            for (k, &i) in self.system.dofs(t).iter().enumerate() {
+                if i != usize::MAX {
+                    grad[i] += g[k];
+                }
+            }
+            self.system.add_block(&mut values, t, h);
+        }
+        let rhs: Vec<f64> = grad.iter().map(|g| -g).collect();
+        // The projected Hessian is PSD (and singular along the rotations about a held point); a
+        // shift tiny against its mean diagonal makes it definite, grown if needed. (Against the
+        // largest entry it would swamp every well-shaped triangle while a crowded one's entries
+        // are huge.)
+        let trace: f64 = blocks
+            .iter()
+            .enumerate()
+            .filter_map(|(t, b)| b.as_ref().map(|(_, h)| (t, h)))
+            .map(|(t, h)| (0..6).filter(|&k| self.system.dofs(t)[k] != usize::MAX).map(|k| h[k][k]).sum::<f64>())
+            .sum();
+        let scale = (trace / n.max(1) as f64).max(f64::MIN_POSITIVE);
+        let mut shift = 1e-8 * scale;
+        let step = loop {
+            match self.system.solve(&values, shift, &rhs) {
+                Ok(x) => break x,
+                Err(_) if shift < scale => shift *= 100.0,
+                Err(e) => return Err(e),
+            }
+        };
+        let slope: f64 = step.iter().zip(&grad).map(|(a, g)| a * g).sum();
+        let mut dir = vec![V3::zeros(); s.len()];
+        let mut k = 0;
+        for (v, out) in dir.iter_mut().enumerate() {
+            if !self.fixed[v] {
+                *out = frames[v][0] * step[k] + frames[v][1] * step[k + 1];
+                k += 2;
+            }
+        }
+        Ok((dir, slope))
+    }
+
+    /// The accepted points, their energy and the refused trials; `None` when no step along the
+    /// direction lowers the energy.
+    fn line_search<I: SphereImage>(
+        &self,
+        image: &I,
+        s: &[P3],
+        dir: &[V3],
+        slope: f64,
+        energy: f64,
+        opts: &SphereNewtonOptions,
+    ) -> Option<(Vec<P3>, f64, usize)> {
+        if slope >= 0.0 {
+            return None;
+        }
+        let longest = dir.iter().map(|d| d.norm()).fold(0.0, f64::max);
+        let mut t = if longest > 0.0 { (opts.max_move / longest).min(1.0) } else { 1.0 };
+        let first = (0..self.triangles.len())
+            .into_par_iter()
+            .map(|k| {
+                let tri = self.triangles[k];
+                first_inversion(tri.map(|v| &s[v as usize]), tri.map(|v| &dir[v as usize]), t)
+            })
+            .reduce(|| f64::INFINITY, f64::min);
+        if first.is_finite() {
+            t = t.min(opts.step_fraction * first);
+        }
+        let mut refused = 0;
+        while t > 1e-14 {
+            let trial: Vec<P3> = s.par_iter().zip(dir).map(|(p, d)| P3::from((p.coords + d * t).normalize())).collect();
+            if let Some(e) = self.energy(image, &trial)
+                && e <= energy + 1e-4 * t * slope
+                && e < energy
+                && all_positive(&trial, &self.triangles)
+            {
+                return Some((trial, e, refused));
+            }
+            refused += 1;
+            t *= 0.5;
+        }
+        None
+    }
+}

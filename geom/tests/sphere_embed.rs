@@ -1,0 +1,70 @@
+//! Sphere embeddings of real closed genus-0 meshes (issue 50): every one bijective under the
+//! exact predicate (every spherical triangle positive, total area 4π), with bounded distortion;
+//! and injectivity kept through every accepted Newton step from Tutte's crowded start.
+
+mod common;
+
+use geom::mesh::shapes;
+use geom::progress::NoProgress;
+use geom::sphere::embed::rest_on_unit_sphere;
+use geom::sphere::orient::check;
+use geom::sphere::tutte::{default_pole, tutte_sphere};
+use geom::sphere::{OnSphere, SphereEmbedOptions, SphereNewton, SphereNewtonOptions, embed_sphere};
+
+#[test]
+fn real_genus_zero_meshes_embed_bijectively() {
+    // The cow (2.8k vertices, thin legs and horns) and the peer's plane (5.4k, thin wings).
+    for (name, max_distortion) in [("cow.off", 2.6), ("landmarks/plane_bird/61.off", 2.8)] {
+        let mesh = common::load(name);
+        let e = embed_sphere(&mesh, &SphereEmbedOptions::default(), &NoProgress).unwrap();
+        let c = check(&e.points, &mesh.face_indices());
+        assert!(c.is_bijective(), "{name}: {c:?}");
+        assert!(e.report.distortion < max_distortion, "{name}: {:?}", e.report);
+        assert!(e.report.newton.energy_after < e.report.newton.energy_before, "{name}: {:?}", e.report);
+    }
+}
+
+#[test]
+fn a_closed_mesh_of_higher_genus_is_refused() {
+    let e = embed_sphere(&common::load("torus.obj"), &SphereEmbedOptions::default(), &NoProgress).unwrap_err();
+    assert_eq!(e.code(), "invalid_argument");
+}
+
+/// From Tutte's start of a subdivided icosahedron (crowded toward the link, huge fan triangles),
+/// one Newton step at a time: after every accepted step the placement is still a bijective
+/// spherical triangulation and the energy never rises.
+#[test]
+fn every_accepted_step_keeps_the_embedding_bijective() {
+    // A bumpy sphere: the icosphere with every third vertex pushed out, so it is not its own
+    // optimum.
+    let ico = shapes::icosphere(3);
+    let pos: Vec<_> = ico
+        .positions()
+        .iter()
+        .enumerate()
+        .map(|(i, p)| if i % 3 == 0 { geom::mesh::P3::from(p.coords * 1.3) } else { *p })
+        .collect();
+    let mesh = ico.with_positions(pos).unwrap();
+    let tris = mesh.face_indices();
+    let pole = default_pole(&mesh);
+    let mut points = tutte_sphere(&mesh, pole).unwrap();
+    assert!(check(&points, &tris).is_bijective());
+    let newton =
+        SphereNewton::new(mesh.n_vertices(), tris.clone(), rest_on_unit_sphere(&mesh).unwrap(), &[pole.0]).unwrap();
+    let one = SphereNewtonOptions { max_iterations: 1, ..Default::default() };
+    let mut last = newton.energy(&OnSphere, &points).unwrap();
+    let start = last;
+    let mut steps = 0;
+    for _ in 0..60 {
+        let r = newton.minimize(&OnSphere, &mut points, &one, &NoProgress).unwrap();
+        let c = check(&points, &tris);
+        assert!(c.is_bijective(), "after step {steps}: {c:?}");
+        assert!(r.energy_after <= last, "{} > {last}", r.energy_after);
+        last = r.energy_after;
+        steps += r.iterations;
+        if r.iterations == 0 {
+            break;
+        }
+    }
+    assert!(steps >= 3 && last < 0.5 * start, "{steps} steps, energy {start} -> {last}");
+}

@@ -68,3 +68,35 @@ fn every_accepted_step_keeps_the_embedding_bijective() {
     }
     assert!(steps >= 3 && last < 0.5 * start, "{steps} steps, energy {start} -> {last}");
 }
+
+/// The optimizer with the target surface as the image (`OnTarget`: points located in the
+/// target's sphere embedding and carried onto it): one vertex pulled toward a goal moves there,
+/// every step keeps the placement bijective on the sphere and every image triangle upright, and
+/// the shrink barrier keeps its neighbours from collapsing.
+#[test]
+fn a_pulled_vertex_moves_through_the_target_without_a_fold() {
+    use geom::sphere::locate::{OnTarget, SphereLocator};
+    let mesh = shapes::icosphere(3);
+    let points: Vec<geom::mesh::P3> =
+        mesh.positions().iter().map(|p| geom::mesh::P3::from(p.coords.normalize())).collect();
+    let tris = mesh.face_indices();
+    let image = OnTarget::new(SphereLocator::new(&mesh, &points), mesh.n_vertices());
+    let mut newton =
+        SphereNewton::new(mesh.n_vertices(), tris.clone(), rest_on_unit_sphere(&mesh).unwrap(), &[]).unwrap();
+    let mut s = points.clone();
+    newton.set_reference(&s, 0.5);
+    // Vertex 0 toward a point 0.15 rad away.
+    let p0 = s[0].coords;
+    let side = p0.cross(&geom::mesh::V3::x()).try_normalize(1e-9).unwrap_or_else(geom::mesh::V3::y);
+    let goal = geom::mesh::P3::from((p0 * 0.15f64.cos() + side * 0.15f64.sin()).normalize());
+    newton.set_pull(&[(0, goal)], 50.0).unwrap();
+    let one = SphereNewtonOptions { max_iterations: 1, ..Default::default() };
+    for _ in 0..15 {
+        newton.minimize(&image, &mut s, &one, &NoProgress).unwrap();
+        assert!(check(&s, &tris).is_bijective());
+        assert_eq!(newton.turned_over(&image, &s), Some(0));
+    }
+    let before = p0.angle(&goal.coords);
+    let after = s[0].coords.angle(&goal.coords);
+    assert!(after < 0.5 * before, "{before} -> {after}");
+}

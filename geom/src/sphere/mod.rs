@@ -9,13 +9,17 @@
 //! - [`kernel`]: where a vertex goes inside its ring when a collapse is undone.
 //! - [`multires`]: coarse to fine over a quadric decimation's collapses.
 //! - [`embed`]: a mesh's low-distortion bijective sphere embedding.
+//! - [`align`]: the rotation that carries one embedding's anchors onto the other's.
+//! - [`locate`]: points located in a spherical triangulation and carried onto its surface.
 //!
-//! Imports run downward: `embed` → `multires` → `kernel`, `newton` → `barrier`, `max_step`, `orient`;
+//! Imports run downward: `locate` → `newton`; `embed` → `multires` → `kernel`, `newton` → `barrier`, `max_step`, `orient`;
 //! `tutte` → `linalg`.
 
+pub mod align;
 pub mod barrier;
 pub mod embed;
 pub mod kernel;
+pub mod locate;
 pub mod max_step;
 pub mod multires;
 pub mod newton;

@@ -18,7 +18,7 @@
 //! bijective spherical triangulation stays one through every accepted step: no triangle changes
 //! sign on the continuous path, so the covering's degree stays 1.
 
-use super::barrier::barrier;
+use super::barrier::{barrier, shrink_barrier};
 use super::max_step::first_inversion;
 use super::orient::{all_positive, det};
 use crate::error::{Error, InputError, Result};
@@ -33,20 +33,36 @@ use serde::Serialize;
 /// A triangle's gradient and projected Hessian in its corners' tangent steps.
 type Block = ([f64; 6], [[f64; 6]; 6]);
 
+/// Where a vertex's sphere point lands in space: the point, its derivatives along the tangent
+/// frame, and the outward normal of the surface there (an image triangle whose normal turns
+/// away from any of its corners' normals is turned over: its energy is infinite).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Image {
+    pub x: P3,
+    pub d: [V3; 2],
+    pub up: V3,
+}
+
 /// Where a vertex's sphere point lands in space, and how it moves.
 pub trait SphereImage: Sync {
-    /// The image of vertex `v` placed at `p`, with its derivatives along the tangent frame
-    /// `frame` at `p`; `None` where it has none.
-    fn image(&self, v: u32, p: &P3, frame: &[V3; 2]) -> Option<(P3, [V3; 2])>;
+    /// The image of vertex `v` placed at `p`, with derivatives along the tangent frame `frame`
+    /// at `p`; `None` where it has none.
+    fn image(&self, v: u32, p: &P3, frame: &[V3; 2]) -> Option<Image>;
 }
 
 /// The sphere itself: the image of a point is the point (a sphere embedding's energy).
 pub struct OnSphere;
 
 impl SphereImage for OnSphere {
-    fn image(&self, _v: u32, p: &P3, frame: &[V3; 2]) -> Option<(P3, [V3; 2])> {
-        Some((*p, *frame))
+    fn image(&self, _v: u32, p: &P3, frame: &[V3; 2]) -> Option<Image> {
+        Some(Image { x: *p, d: *frame, up: p.coords })
     }
+}
+
+/// Whether the image triangle's normal agrees with every corner's surface normal.
+fn upright(images: [&Image; 3]) -> bool {
+    let n = (images[1].x - images[0].x).cross(&(images[2].x - images[0].x));
+    images.iter().all(|i| n.dot(&i.up) > 0.0)
 }
 
 /// Options for [`SphereNewton::minimize`].
@@ -88,6 +104,18 @@ pub struct SphereNewton {
     rest: Vec<RestTriangle>,
     fixed: Vec<bool>,
     system: BlockSystem,
+    pull: Pull,
+    /// Per triangle, the reference `det` of the shrink barrier (empty: no shrink barrier).
+    reference: Vec<f64>,
+}
+
+/// Soft goals: `weight / 2 · |p − goal|²` per pulled vertex, its 2×2 Hessian `weight · I`
+/// added into the block of one triangle around it.
+#[derive(Default)]
+struct Pull {
+    weight: f64,
+    /// (vertex, goal, triangle, corner).
+    goals: Vec<(u32, P3, usize, usize)>,
 }
 
 /// A unit tangent frame at `p` (right-handed with the outward normal).
@@ -139,7 +167,38 @@ impl SphereNewton {
             })
             .collect();
         let system = BlockSystem::new(&free_index, &triangles)?;
-        Ok(Self { triangles, rest, fixed: is_fixed, system })
+        Ok(Self { triangles, rest, fixed: is_fixed, system, pull: Pull::default(), reference: Vec::new() })
+    }
+
+    /// Makes every triangle resist shrinking on the sphere below `fraction` of its size at
+    /// `s` ([`shrink_barrier`]).
+    pub fn set_reference(&mut self, s: &[P3], fraction: f64) {
+        self.reference = self
+            .triangles
+            .iter()
+            .map(|t| fraction * det(&s[t[0] as usize], &s[t[1] as usize], &s[t[2] as usize]))
+            .collect();
+    }
+
+    /// Pulls free vertices toward goals with `weight / 2 · |p − goal|²` each (the soft landmark
+    /// phase); replaces any earlier pull.
+    ///
+    /// # Errors
+    /// `Invalid` for a vertex outside the mesh, fixed, or in no triangle.
+    pub fn set_pull(&mut self, goals: &[(u32, P3)], weight: f64) -> Result<()> {
+        let mut out = Vec::with_capacity(goals.len());
+        for &(v, g) in goals {
+            let slot = self
+                .triangles
+                .iter()
+                .enumerate()
+                .find_map(|(t, tri)| tri.iter().position(|&x| x == v).map(|k| (t, k)))
+                .filter(|_| !self.fixed.get(v as usize).copied().unwrap_or(true))
+                .ok_or_else(|| InputError::Invalid(format!("vertex {v} cannot be pulled")))?;
+            out.push((v, g, slot.0, slot.1));
+        }
+        self.pull = Pull { weight, goals: out };
+        Ok(())
     }
 
     pub fn triangles(&self) -> &[[u32; 3]] {
@@ -147,11 +206,11 @@ impl SphereNewton {
     }
 
     /// The energy at sphere points `s`; `None` when a triangle is not positive (in floating
-    /// point) or an image is degenerate.
+    /// point), or an image is degenerate or turned over.
     pub fn energy<I: SphereImage>(&self, image: &I, s: &[P3]) -> Option<f64> {
         let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
-        let images: Option<Vec<P3>> =
-            s.par_iter().enumerate().map(|(v, p)| image.image(v as u32, p, &frames[v]).map(|x| x.0)).collect();
+        let images: Option<Vec<Image>> =
+            s.par_iter().enumerate().map(|(v, p)| image.image(v as u32, p, &frames[v])).collect();
         let images = images?;
         let e: f64 = (0..self.triangles.len())
             .into_par_iter()
@@ -161,13 +220,30 @@ impl SphereNewton {
                 if det(a, b, c) <= 0.0 {
                     return f64::INFINITY;
                 }
-                let guard = barrier(self.rest[t].area(), [a, b, c]).map_or(f64::INFINITY, |g| g.0);
-                chord_layout(tri.map(|v| images[v as usize]))
-                    .and_then(|(x, _)| self.rest[t].energy_in(x, &IDENTITY))
-                    .map_or(f64::INFINITY, |e| e + guard)
+                let im = tri.map(|v| &images[v as usize]);
+                let mut guard = barrier(self.rest[t].area(), [a, b, c]).map_or(f64::INFINITY, |g| g.0);
+                if let Some(&d0) = self.reference.get(t) {
+                    guard += shrink_barrier(self.rest[t].area(), d0, [a, b, c]).map_or(f64::INFINITY, |g| g.0);
+                }
+                if !upright(im) {
+                    return f64::INFINITY;
+                }
+                let e = chord_layout(im.map(|i| i.x)).and_then(|(x, _)| self.rest[t].energy_in(x, &IDENTITY));
+                e.map_or(f64::INFINITY, |e| e + guard)
             })
             .sum();
+        let pull: f64 =
+            self.pull.goals.iter().map(|(v, g, ..)| 0.5 * self.pull.weight * (s[*v as usize] - g).norm_squared()).sum();
+        let e = e + pull;
         e.is_finite().then_some(e)
+    }
+
+    /// Image triangles turned over (their normal away from a corner's surface normal).
+    pub fn turned_over<I: SphereImage>(&self, image: &I, s: &[P3]) -> Option<usize> {
+        let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
+        let images: Vec<Image> =
+            s.par_iter().enumerate().map(|(v, p)| image.image(v as u32, p, &frames[v])).collect::<Option<_>>()?;
+        Some(self.triangles.par_iter().filter(|t| !upright(t.map(|v| &images[v as usize]))).count())
     }
 
     /// Minimizes the energy from the bijective start `s`, in place; every accepted step keeps
@@ -221,7 +297,7 @@ impl SphereNewton {
     /// gradient dotted into it.
     fn direction<I: SphereImage>(&self, image: &I, s: &[P3]) -> Result<(Vec<V3>, f64)> {
         let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
-        let images: Vec<(P3, [V3; 2])> = s
+        let images: Vec<Image> = s
             .par_iter()
             .enumerate()
             .map(|(v, p)| image.image(v as u32, p, &frames[v]))
@@ -231,14 +307,21 @@ impl SphereNewton {
             .into_par_iter()
             .map(|t| {
                 let tri = self.triangles[t];
-                let (x, [u, w]) = chord_layout(tri.map(|v| images[v as usize].0))?;
+                let (x, [u, w]) = chord_layout(tri.map(|v| images[v as usize].x))?;
                 let m: [Mat2; 3] = tri.map(|v| {
-                    let a = &images[v as usize].1;
+                    let a = &images[v as usize].d;
                     [[u.dot(&a[0]), u.dot(&a[1])], [w.dot(&a[0]), w.dot(&a[1])]]
                 });
                 let (_, mut g, mut h) = self.rest[t].derivatives_in(x, &IDENTITY, &m)?;
-                let (value, gb, k) = barrier(self.rest[t].area(), tri.map(|v| &s[v as usize]))?;
-                if value > 0.0 {
+                let corners = tri.map(|v| &s[v as usize]);
+                let mut guards = vec![barrier(self.rest[t].area(), corners)?];
+                if let Some(&d0) = self.reference.get(t) {
+                    guards.push(shrink_barrier(self.rest[t].area(), d0, corners)?);
+                }
+                for (value, gb, k) in guards {
+                    if value <= 0.0 {
+                        continue;
+                    }
                     let mut q = [0.0; 6];
                     for (i, &v) in tri.iter().enumerate() {
                         for j in 0..2 {
@@ -258,6 +341,16 @@ impl SphereNewton {
         let n = self.system.len();
         let mut grad = vec![0.0; n];
         let mut values = self.system.zero_values();
+        let mut blocks = blocks;
+        for &(v, g, t, k) in &self.pull.goals {
+            if let Some((gr, h)) = blocks[t].as_mut() {
+                let d = (s[v as usize] - g) * self.pull.weight;
+                for j in 0..2 {
+                    gr[2 * k + j] += frames[v as usize][j].dot(&d);
+                    h[2 * k + j][2 * k + j] += self.pull.weight;
+                }
+            }
+        }
         for (t, b) in blocks.iter().enumerate() {
             let (g, h) =
                 b.as_ref().ok_or_else(|| Error::Internal("a degenerate image inside the optimization".into()))?;

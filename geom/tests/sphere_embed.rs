@@ -100,3 +100,18 @@ fn a_pulled_vertex_moves_through_the_target_without_a_fold() {
     let after = s[0].coords.angle(&goal.coords);
     assert!(after < 0.5 * before, "{before} -> {after}");
 }
+
+/// A mesh's own embedding read through itself (the identity map) has no image turned over,
+/// even at the cow's sharp vertices, where a face can turn away from a neighbouring face's
+/// normal: the test is the evaluator's, against the surface under the triangle.
+#[test]
+fn the_identity_through_the_target_has_no_turned_over_image() {
+    use geom::sphere::locate::{OnTarget, SphereLocator};
+    let mesh = common::load("cow.off");
+    let e = embed_sphere(&mesh, &SphereEmbedOptions::default(), &NoProgress).unwrap();
+    let image = OnTarget::new(SphereLocator::new(&mesh, &e.points), mesh.n_vertices());
+    let newton =
+        SphereNewton::new(mesh.n_vertices(), mesh.face_indices(), rest_on_unit_sphere(&mesh).unwrap(), &[]).unwrap();
+    assert_eq!(newton.turned_over(&image, &e.points), Some(0));
+    assert!(newton.energy(&image, &e.points).is_some());
+}

@@ -18,8 +18,8 @@ pub struct SphereLocator<'m> {
     mesh: &'m Mesh,
     points: &'m [P3],
     tris: Vec<[u32; 3]>,
-    /// Unit face normals, and area-weighted unit vertex normals (the normal at a point that
-    /// sits on a vertex, as an anchor does).
+    /// Unit face normals, and per vertex the normal at a point that sits on it (as an anchor
+    /// does).
     face_normals: Vec<V3>,
     vertex_normals: Vec<V3>,
 }
@@ -36,20 +36,22 @@ impl<'m> SphereLocator<'m> {
     pub fn new(mesh: &'m Mesh, points: &'m [P3]) -> Self {
         let face_raw: Vec<V3> = (0..mesh.n_faces()).map(|f| mesh.face_normal_raw(crate::FaceId::from_idx(f))).collect();
         let tris = mesh.face_indices();
-        let mut vertex_normals = vec![V3::zeros(); mesh.n_vertices()];
-        for (t, n) in tris.iter().zip(&face_raw) {
+        let unit = |n: &V3| n.try_normalize(0.0).unwrap_or_else(V3::zeros);
+        let face_normals: Vec<V3> = face_raw.iter().map(unit).collect();
+        // At a vertex, the normal of the adjacent face whose centroid is nearest: the face the
+        // evaluator's closest-point search settles on for a point that sits on the vertex.
+        let pos = mesh.positions();
+        let mut best = vec![(f64::INFINITY, V3::zeros()); mesh.n_vertices()];
+        for (f, t) in tris.iter().enumerate() {
+            let c = (pos[t[0] as usize].coords + pos[t[1] as usize].coords + pos[t[2] as usize].coords) / 3.0;
             for &v in t {
-                vertex_normals[v as usize] += n;
+                let d = (c - pos[v as usize].coords).norm_squared();
+                if d < best[v as usize].0 {
+                    best[v as usize] = (d, face_normals[f]);
+                }
             }
         }
-        let unit = |n: &V3| n.try_normalize(0.0).unwrap_or_else(V3::zeros);
-        Self {
-            mesh,
-            points,
-            face_normals: face_raw.iter().map(unit).collect(),
-            vertex_normals: vertex_normals.iter().map(unit).collect(),
-            tris,
-        }
+        Self { mesh, points, face_normals, vertex_normals: best.into_iter().map(|b| b.1).collect(), tris }
     }
 
     pub fn mesh(&self) -> &Mesh {
@@ -172,7 +174,11 @@ impl SphereImage for OnTarget<'_> {
     fn image(&self, v: u32, p: &P3, frame: &[V3; 2]) -> Option<Image> {
         let l = self.locate(v, p);
         let (x, d) = self.locator.image_in(l.face, p, frame);
-        Some(Image { x, d, up: self.locator.normal(&l) })
+        Some(Image { x, d })
+    }
+    fn up_at(&self, near: u32, p: &P3) -> V3 {
+        let hint = self.hints.get(near as usize).map_or(0, |h| h.load(Ordering::Relaxed));
+        self.locator.normal(&self.locator.locate(p, hint))
     }
 }
 

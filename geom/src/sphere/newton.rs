@@ -33,21 +33,24 @@ use serde::Serialize;
 /// A triangle's gradient and projected Hessian in its corners' tangent steps.
 type Block = ([f64; 6], [[f64; 6]; 6]);
 
-/// Where a vertex's sphere point lands in space: the point, its derivatives along the tangent
-/// frame, and the outward normal of the surface there (an image triangle whose normal turns
-/// away from any of its corners' normals is turned over: its energy is infinite).
+/// Where a vertex's sphere point lands in space: the point and its derivatives along the
+/// tangent frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Image {
     pub x: P3,
     pub d: [V3; 2],
-    pub up: V3,
 }
 
-/// Where a vertex's sphere point lands in space, and how it moves.
+/// Where a vertex's sphere point lands in space, how it moves, and which way is out there (an
+/// image triangle whose normal turns away from the surface under its centroid is turned over:
+/// its energy is infinite).
 pub trait SphereImage: Sync {
     /// The image of vertex `v` placed at `p`, with derivatives along the tangent frame `frame`
     /// at `p`; `None` where it has none.
     fn image(&self, v: u32, p: &P3, frame: &[V3; 2]) -> Option<Image>;
+    /// The surface normal under the sphere point `p` (a triangle's centroid), found from where
+    /// vertex `near` was last.
+    fn up_at(&self, near: u32, p: &P3) -> V3;
 }
 
 /// The sphere itself: the image of a point is the point (a sphere embedding's energy).
@@ -55,14 +58,26 @@ pub struct OnSphere;
 
 impl SphereImage for OnSphere {
     fn image(&self, _v: u32, p: &P3, frame: &[V3; 2]) -> Option<Image> {
-        Some(Image { x: *p, d: *frame, up: p.coords })
+        Some(Image { x: *p, d: *frame })
+    }
+    fn up_at(&self, _near: u32, p: &P3) -> V3 {
+        p.coords
     }
 }
 
-/// Whether the image triangle's normal agrees with every corner's surface normal.
-fn upright(images: [&Image; 3]) -> bool {
+/// Whether the image triangle's normal agrees with the surface normal under its centroid
+/// (`up`). Then it is not a flip as the evaluator counts one (a face whose normal opposes the
+/// surface under every corner and its centroid). (Asking every corner's normal to agree is
+/// wrong at sharp vertices: it calls even the identity map of the cow turned over.)
+fn upright(images: [&Image; 3], up: &V3) -> bool {
     let n = (images[1].x - images[0].x).cross(&(images[2].x - images[0].x));
-    images.iter().all(|i| n.dot(&i.up) > 0.0)
+    n.dot(up) > 0.0
+}
+
+/// The surface normal under triangle `tri`'s centroid on the sphere.
+fn up_of<I: SphereImage>(image: &I, s: &[P3], tri: [u32; 3]) -> V3 {
+    let c = (s[tri[0] as usize].coords + s[tri[1] as usize].coords + s[tri[2] as usize].coords).normalize();
+    image.up_at(tri[0], &P3::from(c))
 }
 
 /// Options for [`SphereNewton::minimize`].
@@ -225,7 +240,7 @@ impl SphereNewton {
                 if let Some(&d0) = self.reference.get(t) {
                     guard += shrink_barrier(self.rest[t].area(), d0, [a, b, c]).map_or(f64::INFINITY, |g| g.0);
                 }
-                if !upright(im) {
+                if !upright(im, &up_of(image, s, tri)) {
                     return f64::INFINITY;
                 }
                 let e = chord_layout(im.map(|i| i.x)).and_then(|(x, _)| self.rest[t].energy_in(x, &IDENTITY));
@@ -243,7 +258,12 @@ impl SphereNewton {
         let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
         let images: Vec<Image> =
             s.par_iter().enumerate().map(|(v, p)| image.image(v as u32, p, &frames[v])).collect::<Option<_>>()?;
-        Some(self.triangles.par_iter().filter(|t| !upright(t.map(|v| &images[v as usize]))).count())
+        Some(
+            self.triangles
+                .par_iter()
+                .filter(|&&t| !upright(t.map(|v| &images[v as usize]), &up_of(image, s, t)))
+                .count(),
+        )
     }
 
     /// Minimizes the energy from the bijective start `s`, in place; every accepted step keeps

@@ -5,7 +5,7 @@
 //! (AMD); each iteration only assembles values, factors numerically and solves
 //! ([`BlockSystem::solve`]), checking the residual, as `linalg::solver` does for Laplacians.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, InputError, Result};
 use crate::tol;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky};
@@ -29,6 +29,51 @@ pub struct BlockSystem {
 }
 
 impl BlockSystem {
+    /// The system of `triangles` over `n_vertices` with the vertices in `fixed` held, and which
+    /// vertices are fixed: what every optimizer over a triangulation builds first.
+    ///
+    /// # Errors
+    /// `Invalid` for a vertex out of range (in a triangle or in `fixed`); as [`BlockSystem::new`].
+    pub fn for_vertices(n_vertices: usize, triangles: &[[u32; 3]], fixed: &[u32]) -> Result<(BlockSystem, Vec<bool>)> {
+        if triangles.iter().flatten().any(|&v| v as usize >= n_vertices) {
+            return Err(InputError::Invalid("a triangle names a vertex out of range".into()).into());
+        }
+        let mut is_fixed = vec![false; n_vertices];
+        for &v in fixed {
+            *is_fixed.get_mut(v as usize).ok_or_else(|| InputError::Invalid(format!("fixed vertex {v}")))? = true;
+        }
+        let mut next = 0u32;
+        let free_index: Vec<u32> = is_fixed
+            .iter()
+            .map(|&f| {
+                if f {
+                    u32::MAX
+                } else {
+                    next += 1;
+                    next - 1
+                }
+            })
+            .collect();
+        Ok((BlockSystem::new(&free_index, triangles)?, is_fixed))
+    }
+
+    /// Solves `(H + shift·I) x = rhs` from `shift = first`, growing the shift a hundredfold
+    /// while the factorization fails and it is below `last` (a projected Hessian is only
+    /// semi-definite).
+    ///
+    /// # Errors
+    /// As [`BlockSystem::solve`], for the last shift tried.
+    pub fn solve_shifted(&self, values: &[f64], rhs: &[f64], first: f64, last: f64) -> Result<Vec<f64>> {
+        let mut shift = first;
+        loop {
+            match self.solve(values, shift, rhs) {
+                Ok(x) => return Ok(x),
+                Err(_) if shift < last => shift *= 100.0,
+                Err(e) => return Err(e),
+            }
+        }
+    }
+
     /// The system of `triangles` over vertices whose free index is `free_index[v]`
     /// (`u32::MAX` for fixed vertices).
     ///

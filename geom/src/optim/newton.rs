@@ -102,26 +102,10 @@ impl InjectiveNewton {
     /// # Errors
     /// `Invalid` for mismatched lengths or an out-of-range vertex; as [`BlockSystem::new`].
     pub fn new(n_vertices: usize, triangles: Vec<[u32; 3]>, rest: Vec<RestTriangle>, fixed: &[u32]) -> Result<Self> {
-        if rest.len() != triangles.len() || triangles.iter().flatten().any(|&v| v as usize >= n_vertices) {
-            return Err(InputError::Invalid("triangles and rest shapes do not match the vertices".into()).into());
+        if rest.len() != triangles.len() {
+            return Err(InputError::Invalid("triangles and rest shapes do not match".into()).into());
         }
-        let mut is_fixed = vec![false; n_vertices];
-        for &v in fixed {
-            *is_fixed.get_mut(v as usize).ok_or_else(|| InputError::Invalid(format!("fixed vertex {v}")))? = true;
-        }
-        let mut next = 0u32;
-        let free_index: Vec<u32> = is_fixed
-            .iter()
-            .map(|&f| {
-                if f {
-                    u32::MAX
-                } else {
-                    next += 1;
-                    next - 1
-                }
-            })
-            .collect();
-        let system = BlockSystem::new(&free_index, &triangles)?;
+        let (system, is_fixed) = BlockSystem::for_vertices(n_vertices, &triangles, fixed)?;
         Ok(Self { triangles, rest, fixed: is_fixed, system })
     }
 
@@ -348,14 +332,7 @@ impl InjectiveNewton {
         let rhs: Vec<f64> = grad.iter().map(|g| -g).collect();
         // The projected Hessian is PSD; a tiny shift makes it definite, grown if needed.
         let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
-        let mut shift = 1e-10 * scale;
-        let step = loop {
-            match self.system.solve(&values, shift, &rhs) {
-                Ok(x) => break x,
-                Err(_) if shift < 1e-2 * scale => shift *= 100.0,
-                Err(e) => return Err(e),
-            }
-        };
+        let step = self.system.solve_shifted(&values, &rhs, 1e-10 * scale, 1e-2 * scale)?;
         let slope: f64 = step.iter().zip(&grad).map(|(a, g)| a * g).sum();
         let mut dir = vec![[0.0; 2]; self.fixed.len()];
         let mut k = 0;

@@ -69,6 +69,22 @@ pub fn shrink_barrier(w: f64, det0: f64, p: [&P3; 3]) -> Option<(f64, [V3; 3], f
 mod tests {
     use super::*;
 
+    /// Central differences of `f` at `p` match the gradient `g`.
+    fn agrees_with_differences(f: &dyn Fn([&P3; 3]) -> f64, p: [P3; 3], g: &[V3; 3]) {
+        let h = 1e-7;
+        for (i, gi) in g.iter().enumerate() {
+            for (k, &gik) in gi.iter().enumerate() {
+                let mut q = p;
+                q[i].coords[k] += h;
+                let ep = f([&q[0], &q[1], &q[2]]);
+                q[i].coords[k] -= 2.0 * h;
+                let em = f([&q[0], &q[1], &q[2]]);
+                let fd = (ep - em) / (2.0 * h);
+                assert!((fd - gik).abs() <= 1e-4 * (1.0 + fd.abs()), "corner {i} axis {k}: {fd} vs {gik}");
+            }
+        }
+    }
+
     #[test]
     fn zero_on_small_triangles_infinite_toward_a_great_circle_and_its_gradient_is_right() {
         let small = [
@@ -81,18 +97,7 @@ mod tests {
         let p = [P3::new(1.0, 0.0, 0.0), P3::from(V3::new(0.0, 1.0, -0.05).normalize()), P3::new(-1.0, 0.01, 0.0)];
         let (e, g, _) = barrier(1.0, [&p[0], &p[1], &p[2]]).unwrap();
         assert!(e > 10.0, "{e}");
-        let h = 1e-7;
-        for (i, gi) in g.iter().enumerate() {
-            for (k, &gik) in gi.iter().enumerate() {
-                let mut q = p;
-                q[i].coords[k] += h;
-                let ep = barrier(1.0, [&q[0], &q[1], &q[2]]).unwrap().0;
-                q[i].coords[k] -= 2.0 * h;
-                let em = barrier(1.0, [&q[0], &q[1], &q[2]]).unwrap().0;
-                let fd = (ep - em) / (2.0 * h);
-                assert!((fd - gik).abs() <= 1e-4 * (1.0 + fd.abs()), "corner {i} axis {k}: {fd} vs {gik}");
-            }
-        }
+        agrees_with_differences(&|q| barrier(1.0, q).unwrap().0, p, &g);
         // Inverted: refused.
         assert!(barrier(1.0, [&p[0], &p[2], &p[1]]).is_none());
     }
@@ -109,18 +114,7 @@ mod tests {
         // Against a reference three times its size it pays, and more as it shrinks further.
         let (e, g, _) = shrink_barrier(1.0, 3.0 * d, [&p[0], &p[1], &p[2]]).unwrap();
         assert!(e > 0.0);
-        let h = 1e-7;
-        for (i, gi) in g.iter().enumerate() {
-            for (k, &gik) in gi.iter().enumerate() {
-                let mut q = p;
-                q[i].coords[k] += h;
-                let ep = shrink_barrier(1.0, 3.0 * d, [&q[0], &q[1], &q[2]]).unwrap().0;
-                q[i].coords[k] -= 2.0 * h;
-                let em = shrink_barrier(1.0, 3.0 * d, [&q[0], &q[1], &q[2]]).unwrap().0;
-                let fd = (ep - em) / (2.0 * h);
-                assert!((fd - gik).abs() <= 1e-4 * (1.0 + fd.abs()), "corner {i} axis {k}: {fd} vs {gik}");
-            }
-        }
+        agrees_with_differences(&|q| shrink_barrier(1.0, 3.0 * d, q).unwrap().0, p, &g);
         assert!(shrink_barrier(1.0, d, [&p[0], &p[2], &p[1]]).is_none());
     }
 }

@@ -10,12 +10,12 @@
 //! 3. The result is checked once more ([`super::orient::check`]: every triangle positive, total
 //!    area 4π) and refused as a numerical failure otherwise; it is never returned folded.
 
-use super::multires::{BASE_VERTICES, Hierarchy, LEVEL_GROWTH, LEVEL_ITERATIONS};
+use super::multires::{self, BASE_VERTICES, Hierarchy, LEVEL_GROWTH, LEVEL_ITERATIONS};
 use super::newton::{SphereNewtonOptions, SphereNewtonResult};
 use super::orient::check;
 use super::tutte::{default_pole, tutte_sphere};
 use crate::error::{Error, InputError, Result};
-use crate::mesh::{FaceId, Mesh, P3};
+use crate::mesh::{Mesh, P3};
 use crate::optim::RestTriangle;
 use crate::progress::Progress;
 use crate::topology;
@@ -47,14 +47,11 @@ pub struct SphereEmbedReport {
 }
 
 /// The rest shapes of `mesh`'s faces, scaled so the total area is the unit sphere's 4π.
+///
+/// # Errors
+/// `Numerical` for a degenerate face.
 pub fn rest_on_unit_sphere(mesh: &Mesh) -> Result<Vec<RestTriangle>> {
-    let scale = (4.0 * std::f64::consts::PI / mesh.area()).sqrt();
-    (0..mesh.n_faces())
-        .map(|f| {
-            let p = mesh.face_points(FaceId::from_idx(f)).map(|q| P3::from(q.coords * scale));
-            RestTriangle::from_3d(p).ok_or_else(|| Error::Numerical(format!("face {f} is degenerate")))
-        })
-        .collect()
+    multires::rest_on_unit_sphere(mesh.positions(), &mesh.face_indices())
 }
 
 /// Embeds the closed genus-0 `mesh` on the unit sphere, bijectively.
@@ -126,7 +123,8 @@ pub fn embed_sphere(mesh: &Mesh, opts: &SphereEmbedOptions, progress: &dyn Progr
             end.degree
         )));
     }
-    let bound = 4.0 * rest_on_unit_sphere(mesh)?.iter().map(RestTriangle::area).sum::<f64>();
+    // Every triangle an isometry: 4 × the rest area, which is the sphere's 4π.
+    let bound = 16.0 * std::f64::consts::PI;
     let r = total;
     Ok(SphereEmbedding {
         points,

@@ -171,21 +171,7 @@ impl<'m> Hierarchy<'m> {
             local[v as usize] = i as u32;
         }
         let tris: Vec<[u32; 3]> = faces.iter().map(|t| t.map(|v| local[v as usize])).collect();
-        let pos = self.mesh.positions();
-        let area: f64 = faces
-            .iter()
-            .map(|t| {
-                0.5 * (pos[t[1] as usize] - pos[t[0] as usize]).cross(&(pos[t[2] as usize] - pos[t[0] as usize])).norm()
-            })
-            .sum();
-        let scale = (4.0 * std::f64::consts::PI / area).sqrt();
-        let rest = faces
-            .iter()
-            .map(|t| {
-                RestTriangle::from_3d(t.map(|v| P3::from(pos[v as usize].coords * scale)))
-                    .ok_or_else(|| Error::Numerical("a degenerate face on the sphere's level mesh".into()))
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let rest = rest_on_unit_sphere(self.mesh.positions(), &faces)?;
         let fixed: Vec<u32> = held.iter().map(|&v| local[v as usize]).filter(|&v| v != u32::MAX).collect();
         let newton = SphereNewton::new(alive.len(), tris, rest, &fixed)?;
         let mut s: Vec<P3> = alive.iter().map(|&v| points[v as usize]).collect();
@@ -195,6 +181,31 @@ impl<'m> Hierarchy<'m> {
         }
         Ok(r)
     }
+}
+
+/// The rest shapes of `faces` (over `positions`), scaled so their total area is the unit
+/// sphere's 4π.
+///
+/// # Errors
+/// `Numerical` for a degenerate face.
+pub fn rest_on_unit_sphere(positions: &[P3], faces: &[[u32; 3]]) -> Result<Vec<RestTriangle>> {
+    let corners = |t: &[u32; 3]| t.map(|v| positions[v as usize]);
+    let area: f64 = faces
+        .iter()
+        .map(|t| {
+            let [a, b, c] = corners(t);
+            0.5 * (b - a).cross(&(c - a)).norm()
+        })
+        .sum();
+    let scale = (4.0 * std::f64::consts::PI / area).sqrt();
+    faces
+        .iter()
+        .enumerate()
+        .map(|(f, t)| {
+            RestTriangle::from_3d(corners(t).map(|p| P3::from(p.coords * scale)))
+                .ok_or_else(|| Error::Numerical(format!("face {f} is degenerate")))
+        })
+        .collect()
 }
 
 /// Points ever closer to `to` inside its fan over the ring (the fan's widest triangle, toward

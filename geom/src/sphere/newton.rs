@@ -162,26 +162,10 @@ impl SphereNewton {
     /// # Errors
     /// `Invalid` for mismatched lengths or an out-of-range vertex; as [`BlockSystem::new`].
     pub fn new(n_vertices: usize, triangles: Vec<[u32; 3]>, rest: Vec<RestTriangle>, fixed: &[u32]) -> Result<Self> {
-        if rest.len() != triangles.len() || triangles.iter().flatten().any(|&v| v as usize >= n_vertices) {
-            return Err(InputError::Invalid("triangles and rest shapes do not match the vertices".into()).into());
+        if rest.len() != triangles.len() {
+            return Err(InputError::Invalid("triangles and rest shapes do not match".into()).into());
         }
-        let mut is_fixed = vec![false; n_vertices];
-        for &v in fixed {
-            *is_fixed.get_mut(v as usize).ok_or_else(|| InputError::Invalid(format!("fixed vertex {v}")))? = true;
-        }
-        let mut next = 0u32;
-        let free_index: Vec<u32> = is_fixed
-            .iter()
-            .map(|&f| {
-                if f {
-                    u32::MAX
-                } else {
-                    next += 1;
-                    next - 1
-                }
-            })
-            .collect();
-        let system = BlockSystem::new(&free_index, &triangles)?;
+        let (system, is_fixed) = BlockSystem::for_vertices(n_vertices, &triangles, fixed)?;
         Ok(Self { triangles, rest, fixed: is_fixed, system, pull: Pull::default(), reference: Vec::new() })
     }
 
@@ -393,14 +377,7 @@ impl SphereNewton {
             .map(|(t, h)| (0..6).filter(|&k| self.system.dofs(t)[k] != usize::MAX).map(|k| h[k][k]).sum::<f64>())
             .sum();
         let scale = (trace / n.max(1) as f64).max(f64::MIN_POSITIVE);
-        let mut shift = 1e-8 * scale;
-        let step = loop {
-            match self.system.solve(&values, shift, &rhs) {
-                Ok(x) => break x,
-                Err(_) if shift < scale => shift *= 100.0,
-                Err(e) => return Err(e),
-            }
-        };
+        let step = self.system.solve_shifted(&values, &rhs, 1e-8 * scale, scale)?;
         let slope: f64 = step.iter().zip(&grad).map(|(a, g)| a * g).sum();
         let mut dir = vec![V3::zeros(); s.len()];
         let mut k = 0;

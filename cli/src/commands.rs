@@ -166,6 +166,7 @@ pub fn map(
             let m = match method {
                 "greedy" => Method::Greedy,
                 "homology" => Method::Homology,
+                "spherical" => Method::Spherical,
                 _ => Method::Voronoi,
             };
             JobSpec::from_anchors_json(&read_bytes(a)?, m)?

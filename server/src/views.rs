@@ -144,8 +144,8 @@ pub struct MeshesJobRequest {
 #[derive(Debug, ToSchema)]
 #[allow(dead_code)]
 pub struct SpecOutline {
-    /// voronoi | greedy | homology | quad
-    #[schema(pattern = "^(voronoi|greedy|homology|quad)$")]
+    /// voronoi | greedy | homology | quad | spherical
+    #[schema(pattern = "^(voronoi|greedy|homology|quad|spherical)$")]
     method: String,
     /// Rows: `[source, target]` vertex ids for pair jobs (or `{"source": [x, y, z], "target":
     /// [x, y, z]}`, or `{"source": {"face": f, "bary": [u, v, w]}, "target": ...}` surface

@@ -105,6 +105,12 @@ impl RestTriangle {
         Vector4::new(lj(0, 0), lj(0, 1), lj(1, 0), lj(1, 1))
     }
 
+    /// `det J` at image corners `x` (negative when the image is inverted).
+    pub fn jacobian_det(&self, x: [Uv; 3]) -> f64 {
+        let v = self.jacobian_in(x, &IDENTITY);
+        v[0] * v[3] - v[1] * v[2]
+    }
+
     /// The energy at image positions `x`; `None` when the image is degenerate or inverted.
     pub fn energy(&self, x: [Uv; 3]) -> Option<f64> {
         self.energy_in(x, &IDENTITY)

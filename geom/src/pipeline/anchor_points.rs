@@ -44,6 +44,7 @@ fn rows_mut(spec: &mut JobSpec) -> Option<&mut Vec<AnchorRow>> {
     match spec {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => Some(&mut s.anchors),
         JobSpec::Homology(s) => Some(&mut s.anchors),
+        JobSpec::Spherical(s) => Some(&mut s.anchors),
         JobSpec::Quad(_) => None,
     }
 }

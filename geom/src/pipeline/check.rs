@@ -3,7 +3,7 @@
 
 use super::anchor_spec::AnchorRow;
 use super::limits::{MAX_ANCHORS, MAX_FEATURES};
-use super::spec::{HomologySpec, JobSpec, LayoutSpec, Method};
+use super::spec::{HomologySpec, JobSpec, LayoutSpec, Method, SphericalSpec};
 use crate::error::{InputError, Result};
 use crate::homology::features::{Curve, check_disjoint, validate_curve};
 use crate::mesh::{Mesh, VertexId};
@@ -36,6 +36,10 @@ impl JobSpec {
                 s.check(a, b).map(|_| ())
             }
             JobSpec::Quad(s) => s.check(summaries).map(|_| ()),
+            JobSpec::Spherical(s) => {
+                let (a, b) = pair(summaries.len())?;
+                s.check(a, b).map(|_| ())
+            }
         }
     }
 }
@@ -84,6 +88,34 @@ impl LayoutSpec {
     /// As [`LayoutSpec::check`].
     pub fn validate(&self, method: Method, source: &Mesh, target: &Mesh) -> Result<Vec<(VertexId, VertexId)>> {
         self.check(method, &topology::summary(source), &topology::summary(target))
+    }
+}
+
+impl SphericalSpec {
+    /// Two connected closed genus-0 meshes, options in range, at least 3 anchors in range and
+    /// distinct. Returns the anchors as vertex pairs.
+    ///
+    /// # Errors
+    /// `InputError::TopologyMismatch`, `InputError::Anchors`, `InputError::OptionRange`.
+    pub fn check(&self, ss: &Summary, ts: &Summary) -> Result<Vec<(VertexId, VertexId)>> {
+        same_topology(ss, ts, false)?;
+        if ss.genus != 0 || ss.boundary_loops != 0 {
+            return Err(InputError::TopologyMismatch(format!(
+                "method spherical maps closed genus-0 surfaces; these have genus {} and {} boundary loops (voronoi and greedy map the others)",
+                ss.genus, ss.boundary_loops
+            ))
+            .into());
+        }
+        self.options.check_ranges()?;
+        anchor_pairs(&self.anchors, Method::Spherical, 3, ss, ts)
+    }
+
+    /// [`SphericalSpec::check`] on the meshes themselves.
+    ///
+    /// # Errors
+    /// As [`SphericalSpec::check`].
+    pub fn validate(&self, source: &Mesh, target: &Mesh) -> Result<Vec<(VertexId, VertexId)>> {
+        self.check(&topology::summary(source), &topology::summary(target))
     }
 }
 

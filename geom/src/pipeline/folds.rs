@@ -116,6 +116,7 @@ fn spec_anchors(spec: &JobSpec) -> Vec<[u64; 2]> {
     match spec {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
         JobSpec::Homology(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
+        JobSpec::Spherical(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
         JobSpec::Quad(_) => Vec::new(),
     }
 }
@@ -142,6 +143,9 @@ fn remedies(spec: &JobSpec) -> &'static str {
     match spec {
         JobSpec::Voronoi(_) | JobSpec::Greedy(_) => {
             "Add anchors near these faces, or check that the anchors keep the same order around each other on both meshes (anchors that cross on one mesh and not the other fold any map)"
+        }
+        JobSpec::Spherical(_) => {
+            "Add anchors near these faces (they sit where a thin part of one surface meets a thick part of the other), or try method voronoi"
         }
         JobSpec::Homology(s) if !s.features.is_empty() => {
             "Set options.meta_mesh: true (its overlay is fold-free by construction), add anchors near these faces, or check the feature curves' order on both meshes"

@@ -57,6 +57,7 @@ pub fn to_welded<'a>(spec: &'a JobSpec, layouts: &[Option<&InputLayout>]) -> Res
                 }
             }
         }
+        JobSpec::Spherical(x) => id_rows(&mut x.anchors, &table)?,
         JobSpec::Homology(h) => {
             id_rows(&mut h.anchors, &table)?;
             for f in &mut h.features {

@@ -47,6 +47,8 @@ impl JobSpec {
         };
         let bytes = match self {
             JobSpec::Voronoi(spec) | JobSpec::Greedy(spec) => pair(&spec.options.layout, spec.options.metric_samples),
+            // Two embeddings, their hierarchies and the Newton systems: per vertex, as a layout.
+            JobSpec::Spherical(spec) => pair(&Default::default(), spec.options.metric_samples),
             // Cut meshes, subdivided bases and the maps, plus what grows with the handles.
             JobSpec::Homology(spec) => {
                 let genus = summaries.iter().map(|s| s.genus.max(0) as u64).max().unwrap_or(0);

@@ -3,7 +3,7 @@
 //!
 //! [`run_job`] dispatches once, on the spec's method, to one pipeline per method
 //! ([`voronoi`] for `voronoi` and `greedy`, [`homology`], [`features`] for `homology` with
-//! feature curves or boundaries, [`quad`]). Each imports [`common`] and the spec, never another
+//! feature curves or boundaries, [`quad`], [`spherical`]). Each imports [`common`] and the spec, never another
 //! method's file.
 
 mod anchor_points;
@@ -27,6 +27,7 @@ pub mod quad;
 mod quad_spec;
 mod ranges;
 mod spec;
+pub mod spherical;
 mod transfer_output;
 pub mod voronoi;
 
@@ -37,7 +38,7 @@ pub use quad::{QuadReport, Remeshes, remesh_all_for_bench};
 pub use quad_spec::{Interpolation, LevelSchedule, MorphDomain, MorphOptions, QuadOptions, QuadSpec};
 pub use spec::{
     FeatureSpec, GlobalOptions, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, METHODS, MapOptions, Method,
-    RelaxOptions,
+    RelaxOptions, SphericalOptions, SphericalSpec,
 };
 
 use crate::error::{InputError, Result};
@@ -53,6 +54,7 @@ pub enum JobReport {
     Homology(homology::HomologyMapReport),
     Features(features::FeatureMapReport),
     Quad(QuadReport),
+    Spherical(spherical::SphericalMapReport),
     /// A pair job on meshes in several parts.
     Parts(Box<parts::PartsReport>),
 }
@@ -65,6 +67,7 @@ impl JobReport {
             JobReport::Homology(r) => Some(&r.pair),
             JobReport::Features(r) => Some(&r.pair),
             JobReport::Parts(r) => Some(&r.pair),
+            JobReport::Spherical(r) => Some(&r.pair),
             JobReport::Quad(_) => None,
         }
     }
@@ -76,6 +79,7 @@ impl JobReport {
             JobReport::Homology(r) => Some(&mut r.pair),
             JobReport::Features(r) => Some(&mut r.pair),
             JobReport::Parts(r) => Some(&mut r.pair),
+            JobReport::Spherical(r) => Some(&mut r.pair),
             JobReport::Quad(_) => None,
         }
     }
@@ -117,6 +121,7 @@ pub fn run_with_layouts(
     let transfer = match spec {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => transfer_output::parse(&s.options.transfer)?,
         JobSpec::Homology(s) => transfer_output::parse(&s.options.transfer)?,
+        JobSpec::Spherical(s) => transfer_output::parse(&s.options.transfer)?,
         JobSpec::Quad(_) => Default::default(),
     };
     let wants_transfer = !transfer.texcoords.is_empty() || transfer.color || transfer.skin;
@@ -140,6 +145,7 @@ pub fn run_with_layouts(
     let inverse = match spec {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => s.options.inverse_morph,
         JobSpec::Homology(s) => s.options.inverse_morph,
+        JobSpec::Spherical(s) => s.options.inverse_morph,
         JobSpec::Quad(_) => false,
     };
     layout_outputs::add_morph(&report, (originals, meshes), &layouts, inverse, &mut arts);
@@ -178,6 +184,11 @@ fn dispatch(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Res
         JobSpec::Quad(s) => {
             let (r, arts) = quad::run(s, meshes, progress)?;
             (JobReport::Quad(r), arts)
+        }
+        JobSpec::Spherical(s) => {
+            let (a, b) = pair()?;
+            let (r, arts) = spherical::run(s, a, b, progress)?;
+            (JobReport::Spherical(r), arts)
         }
     })
 }

@@ -8,7 +8,7 @@
 //! (see [`super::memory`]).
 
 use super::quad_spec::QuadOptions;
-use super::spec::{HomologyOptions, MapOptions};
+use super::spec::{HomologyOptions, MapOptions, SphericalOptions};
 use crate::crossparam::smooth::SmoothOptions;
 use crate::error::{InputError, Result};
 
@@ -90,6 +90,17 @@ impl HomologyOptions {
             }
         }
         smoothing(&self.smoothing)?;
+        size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)
+    }
+}
+
+impl SphericalOptions {
+    /// Checks every option of a `spherical` job against its range.
+    ///
+    /// # Errors
+    /// `InputError::OptionRange` naming the first field out of range and the range.
+    pub fn check_ranges(&self) -> Result<()> {
+        super::transfer_output::parse(&self.transfer)?;
         size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)
     }
 }

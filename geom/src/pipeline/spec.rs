@@ -3,7 +3,8 @@
 //!
 //! `{"method": "voronoi" | "greedy", "anchors": [[s, t], ...], "options": {...}}`,
 //! `{"method": "homology", "anchors": [...], "features": [...], "options": {...}}`,
-//! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}`.
+//! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}`,
+//! `{"method": "spherical", "anchors": [...], "options": {...}}`.
 //! Each method has its own options type; unknown fields are refused at every depth.
 
 use super::anchor_spec::AnchorRow;
@@ -15,7 +16,7 @@ use crate::error::{Error, InputError, Result};
 use serde::{Deserialize, Serialize};
 
 /// Every method a job may name, in [`Method`] order.
-pub const METHODS: [&str; 4] = ["voronoi", "greedy", "homology", "quad"];
+pub const METHODS: [&str; 5] = ["voronoi", "greedy", "homology", "quad", "spherical"];
 
 /// A job: its method, with that method's anchors and options.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -30,6 +31,9 @@ pub enum JobSpec {
     Homology(HomologySpec),
     /// Consistent quad remeshing of N models (Yu & Chuang).
     Quad(QuadSpec),
+    /// Closed genus-0 pairs through bijective sphere embeddings, one injective optimization
+    /// (Schmidt, Pieper & Kobbelt 2023; issue 50).
+    Spherical(SphericalSpec),
 }
 
 /// The method of a job.
@@ -39,6 +43,7 @@ pub enum Method {
     Greedy,
     Homology,
     Quad,
+    Spherical,
 }
 
 impl Method {
@@ -59,6 +64,35 @@ pub struct LayoutSpec {
     pub boundaries: Vec<[u64; 2]>,
     #[serde(default)]
     pub options: MapOptions,
+}
+
+/// A `spherical` job.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphericalSpec {
+    pub anchors: Vec<AnchorRow>,
+    #[serde(default)]
+    pub options: SphericalOptions,
+}
+
+/// Options of a `spherical` job. Every field has a default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SphericalOptions {
+    /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
+    pub metric_samples: usize,
+    /// Source attributes to carry onto the target (`target_transferred.glb`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub transfer: Vec<String>,
+    /// `morph.glb` also holds the target placed on the source (the inverse pair).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub inverse_morph: bool,
+}
+
+impl Default for SphericalOptions {
+    fn default() -> Self {
+        Self { metric_samples: 100_000, transfer: Vec::new(), inverse_morph: false }
+    }
 }
 
 /// A `homology` job.
@@ -285,6 +319,9 @@ impl JobSpec {
                 options: HomologyOptions::default(),
             })),
             Method::Quad => Err(InputError::Spec("a quad job needs a spec (`--spec`)".into()).into()),
+            Method::Spherical => {
+                Ok(JobSpec::Spherical(SphericalSpec { anchors, options: SphericalOptions::default() }))
+            }
         }
     }
 
@@ -294,6 +331,7 @@ impl JobSpec {
             JobSpec::Greedy(_) => Method::Greedy,
             JobSpec::Homology(_) => Method::Homology,
             JobSpec::Quad(_) => Method::Quad,
+            JobSpec::Spherical(_) => Method::Spherical,
         }
     }
 

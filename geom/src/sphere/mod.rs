@@ -11,20 +11,27 @@
 //! - [`embed`]: a mesh's low-distortion bijective sphere embedding.
 //! - [`align`]: the rotation that carries one embedding's anchors onto the other's.
 //! - [`locate`]: points located in a spherical triangulation and carried onto its surface.
+//! - [`landmarks`]: anchors brought onto their partners' points, the triangulation kept bijective.
+//! - [`untangle`]: image triangles turned back upright on the surface, on the sphere.
+//! - [`pair`]: a map between two genus-0 surfaces, bijective at every step.
 //!
-//! Imports run downward: `locate` → `newton`; `embed` → `multires` → `kernel`, `newton` → `barrier`, `max_step`, `orient`;
+//! Imports run downward: `pair` → `landmarks`, `untangle`, `locate`, `align`; `locate` → `newton`; `embed` → `multires` → `kernel`, `newton` → `barrier`, `max_step`, `orient`;
 //! `tutte` → `linalg`.
 
 pub mod align;
 pub mod barrier;
 pub mod embed;
 pub mod kernel;
+pub mod landmarks;
 pub mod locate;
 pub mod max_step;
 pub mod multires;
 pub mod newton;
 pub mod orient;
+pub mod pair;
 pub mod tutte;
+pub mod untangle;
 
 pub use embed::{SphereEmbedOptions, SphereEmbedReport, SphereEmbedding, embed_sphere};
 pub use newton::{OnSphere, SphereImage, SphereNewton, SphereNewtonOptions, SphereNewtonResult};
+pub use pair::{SpherePair, SpherePairOptions, SpherePairReport, sphere_pair};

@@ -25,7 +25,7 @@ use crate::error::{Error, InputError, Result};
 use crate::mesh::{P3, V3};
 use crate::optim::RestTriangle;
 use crate::optim::block_system::BlockSystem;
-use crate::optim::sym_dirichlet::{IDENTITY, Mat2};
+use crate::optim::sym_dirichlet::{Derivatives, IDENTITY, Mat2};
 use crate::progress::Progress;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -78,6 +78,59 @@ fn upright(images: [&Image; 3], up: &V3) -> bool {
 fn up_of<I: SphereImage>(image: &I, s: &[P3], tri: [u32; 3]) -> V3 {
     let c = (s[tri[0] as usize].coords + s[tri[1] as usize].coords + s[tri[2] as usize].coords).normalize();
     image.up_at(tri[0], &P3::from(c))
+}
+
+/// How an image triangle is measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Measure {
+    /// The chord in its own plane (what the evaluator measures); a turned-over image has
+    /// infinite energy, so a start without one never gets one.
+    Upright,
+    /// The chord in its own plane whichever way it faces: a turned-over image has finite
+    /// energy, so a map far from its optimum can pass through them to it (untangled after).
+    Loose,
+    /// The chord projected on the surface's tangent plane under its centroid, its signed
+    /// Jacobian determinant `D` replaced by `χ(D, ε) = (D + √(ε² + D²)) / 2` (Garanzha et al.
+    /// 2021): finite on turned-over images, which it turns back ([`SphereNewton::untangle`]).
+    Untangle(f64),
+}
+
+/// The chord `x` projected on the plane normal to `up`, in that plane's coordinates (`x0` at
+/// the origin, `x1` on the first axis), and the plane's axes; the layout's orientation is the
+/// image's against `up`. `None` when degenerate.
+pub fn projected_layout(x: [P3; 3], up: &V3) -> Option<([[f64; 2]; 3], [V3; 2])> {
+    let n = up.try_normalize(0.0)?;
+    let (e1, e2) = (x[1] - x[0], x[2] - x[0]);
+    let flat = |e: &V3| e - n * n.dot(e);
+    let u = flat(&e1).try_normalize(0.0).or_else(|| flat(&e2).try_normalize(0.0))?;
+    let w = n.cross(&u);
+    let l = [[0.0, 0.0], [e1.dot(&u), e1.dot(&w)], [e2.dot(&u), e2.dot(&w)]];
+    l.iter().flatten().all(|c| c.is_finite()).then_some((l, [u, w]))
+}
+
+impl Measure {
+    /// The triangle's layout and axes as this measure sees it; `None` when refused.
+    fn layout(self, images: [&Image; 3], up: &V3) -> Option<([[f64; 2]; 3], [V3; 2])> {
+        match self {
+            Measure::Upright => upright(images, up).then(|| chord_layout(images.map(|i| i.x))).flatten(),
+            Measure::Loose => chord_layout(images.map(|i| i.x)),
+            Measure::Untangle(_) => projected_layout(images.map(|i| i.x), up),
+        }
+    }
+
+    fn energy(self, rest: &RestTriangle, x: [[f64; 2]; 3]) -> Option<f64> {
+        match self {
+            Measure::Upright | Measure::Loose => rest.energy_in(x, &IDENTITY),
+            Measure::Untangle(eps) => rest.energy_eps(x, &IDENTITY, eps),
+        }
+    }
+
+    fn derivatives(self, rest: &RestTriangle, x: [[f64; 2]; 3], m: &[Mat2; 3]) -> Option<Derivatives> {
+        match self {
+            Measure::Upright | Measure::Loose => rest.derivatives_in(x, &IDENTITY, m),
+            Measure::Untangle(eps) => rest.derivatives_eps(x, &IDENTITY, m, eps),
+        }
+    }
 }
 
 /// Options for [`SphereNewton::minimize`].
@@ -207,10 +260,21 @@ impl SphereNewton {
     /// The energy at sphere points `s`; `None` when a triangle is not positive (in floating
     /// point), or an image is degenerate or turned over.
     pub fn energy<I: SphereImage>(&self, image: &I, s: &[P3]) -> Option<f64> {
+        self.energy_as(Measure::Upright, image, s)
+    }
+
+    /// The vertices' images at `s` with the tangent frames they were taken in.
+    fn images<I: SphereImage>(image: &I, s: &[P3]) -> Option<(Vec<[V3; 2]>, Vec<Image>)> {
         let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
-        let images: Option<Vec<Image>> =
-            s.par_iter().enumerate().map(|(v, p)| image.image(v as u32, p, &frames[v])).collect();
-        let images = images?;
+        let images =
+            s.par_iter().enumerate().map(|(v, p)| image.image(v as u32, p, &frames[v])).collect::<Option<_>>()?;
+        Some((frames, images))
+    }
+
+    /// The energy under `measure`; `None` when a triangle is not positive on the sphere or the
+    /// measure refuses an image.
+    pub fn energy_as<I: SphereImage>(&self, measure: Measure, image: &I, s: &[P3]) -> Option<f64> {
+        let (_, images) = Self::images(image, s)?;
         let e: f64 = (0..self.triangles.len())
             .into_par_iter()
             .map(|t| {
@@ -219,15 +283,12 @@ impl SphereNewton {
                 if det(a, b, c) <= 0.0 {
                     return f64::INFINITY;
                 }
-                let im = tri.map(|v| &images[v as usize]);
                 let mut guard = barrier(self.rest[t].area(), [a, b, c]).map_or(f64::INFINITY, |g| g.0);
                 if let Some(&d0) = self.reference.get(t) {
                     guard += shrink_barrier(self.rest[t].area(), d0, [a, b, c]).map_or(f64::INFINITY, |g| g.0);
                 }
-                if !upright(im, &up_of(image, s, tri)) {
-                    return f64::INFINITY;
-                }
-                let e = chord_layout(im.map(|i| i.x)).and_then(|(x, _)| self.rest[t].energy_in(x, &IDENTITY));
+                let im = tri.map(|v| &images[v as usize]);
+                let e = measure.layout(im, &up_of(image, s, tri)).and_then(|(x, _)| measure.energy(&self.rest[t], x));
                 e.map_or(f64::INFINITY, |e| e + guard)
             })
             .sum();
@@ -237,17 +298,39 @@ impl SphereNewton {
         e.is_finite().then_some(e)
     }
 
-    /// Image triangles turned over (their normal away from a corner's surface normal).
+    /// Image triangles turned over (their normal away from the surface under their centroid).
     pub fn turned_over<I: SphereImage>(&self, image: &I, s: &[P3]) -> Option<usize> {
-        let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
-        let images: Vec<Image> =
-            s.par_iter().enumerate().map(|(v, p)| image.image(v as u32, p, &frames[v])).collect::<Option<_>>()?;
+        Some(self.turned_over_list(image, s)?.len())
+    }
+
+    /// The triangles whose images are turned over.
+    pub fn turned_over_list<I: SphereImage>(&self, image: &I, s: &[P3]) -> Option<Vec<usize>> {
+        let (_, images) = Self::images(image, s)?;
         Some(
-            self.triangles
-                .par_iter()
-                .filter(|&&t| !upright(t.map(|v| &images[v as usize]), &up_of(image, s, t)))
-                .count(),
+            (0..self.triangles.len())
+                .into_par_iter()
+                .filter(|&t| {
+                    let tri = self.triangles[t];
+                    !upright(tri.map(|v| &images[v as usize]), &up_of(image, s, tri))
+                })
+                .collect(),
         )
+    }
+
+    /// The smallest Jacobian determinant of an image projected on the surface under it
+    /// (negative for a turned-over image; `-∞` where degenerate).
+    pub fn min_det<I: SphereImage>(&self, image: &I, s: &[P3]) -> f64 {
+        let Some((_, images)) = Self::images(image, s) else { return f64::NEG_INFINITY };
+        (0..self.triangles.len())
+            .into_par_iter()
+            .map(|t| {
+                let tri = self.triangles[t];
+                let Some((x, _)) = projected_layout(tri.map(|v| images[v as usize].x), &up_of(image, s, tri)) else {
+                    return f64::NEG_INFINITY;
+                };
+                self.rest[t].jacobian_det(x)
+            })
+            .reduce(|| f64::INFINITY, f64::min)
     }
 
     /// Minimizes the energy from the bijective start `s`, in place; every accepted step keeps
@@ -264,7 +347,22 @@ impl SphereNewton {
         opts: &SphereNewtonOptions,
         progress: &dyn Progress,
     ) -> Result<SphereNewtonResult> {
-        let start = match self.energy(image, s) {
+        self.minimize_as(Measure::Upright, image, s, opts, progress)
+    }
+
+    /// [`SphereNewton::minimize`] under `measure`.
+    ///
+    /// # Errors
+    /// As [`SphereNewton::minimize`].
+    pub fn minimize_as<I: SphereImage>(
+        &self,
+        measure: Measure,
+        image: &I,
+        s: &mut Vec<P3>,
+        opts: &SphereNewtonOptions,
+        progress: &dyn Progress,
+    ) -> Result<SphereNewtonResult> {
+        let start = match self.energy_as(measure, image, s) {
             Some(e) if all_positive(s, &self.triangles) => e,
             _ => return Err(InputError::Invalid("the start on the sphere is not injective".into()).into()),
         };
@@ -278,12 +376,12 @@ impl SphereNewton {
         let mut energy = start;
         for _ in 0..opts.max_iterations {
             progress.check()?;
-            let (dir, slope) = self.direction(image, s)?;
+            let (dir, slope) = self.direction(measure, image, s)?;
             if -0.5 * slope < opts.tolerance * energy {
                 r.converged = true;
                 break;
             }
-            let Some((next, e, refused)) = self.line_search(image, s, &dir, slope, energy, opts) else {
+            let Some((next, e, refused)) = self.line_search(measure, image, s, (&dir, slope), energy, opts) else {
                 r.converged = true;
                 break;
             };
@@ -299,24 +397,19 @@ impl SphereNewton {
 
     /// The Newton direction per vertex as a tangent vector (zero on fixed vertices), with the
     /// gradient dotted into it.
-    fn direction<I: SphereImage>(&self, image: &I, s: &[P3]) -> Result<(Vec<V3>, f64)> {
-        let frames: Vec<[V3; 2]> = s.par_iter().map(tangent_frame).collect();
-        let images: Vec<Image> = s
-            .par_iter()
-            .enumerate()
-            .map(|(v, p)| image.image(v as u32, p, &frames[v]))
-            .collect::<Option<_>>()
+    pub(super) fn direction<I: SphereImage>(&self, measure: Measure, image: &I, s: &[P3]) -> Result<(Vec<V3>, f64)> {
+        let (frames, images) = Self::images(image, s)
             .ok_or_else(|| Error::Internal("a vertex without an image inside the optimization".into()))?;
         let blocks: Vec<Option<Block>> = (0..self.triangles.len())
             .into_par_iter()
             .map(|t| {
                 let tri = self.triangles[t];
-                let (x, [u, w]) = chord_layout(tri.map(|v| images[v as usize].x))?;
+                let (x, [u, w]) = measure.layout(tri.map(|v| &images[v as usize]), &up_of(image, s, tri))?;
                 let m: [Mat2; 3] = tri.map(|v| {
                     let a = &images[v as usize].d;
                     [[u.dot(&a[0]), u.dot(&a[1])], [w.dot(&a[0]), w.dot(&a[1])]]
                 });
-                let (_, mut g, mut h) = self.rest[t].derivatives_in(x, &IDENTITY, &m)?;
+                let (_, mut g, mut h) = measure.derivatives(&self.rest[t], x, &m)?;
                 let corners = tri.map(|v| &s[v as usize]);
                 let mut guards = vec![barrier(self.rest[t].area(), corners)?];
                 if let Some(&d0) = self.reference.get(t) {
@@ -392,12 +485,12 @@ impl SphereNewton {
 
     /// The accepted points, their energy and the refused trials; `None` when no step along the
     /// direction lowers the energy.
-    fn line_search<I: SphereImage>(
+    pub(super) fn line_search<I: SphereImage>(
         &self,
+        measure: Measure,
         image: &I,
         s: &[P3],
-        dir: &[V3],
-        slope: f64,
+        (dir, slope): (&[V3], f64),
         energy: f64,
         opts: &SphereNewtonOptions,
     ) -> Option<(Vec<P3>, f64, usize)> {
@@ -419,7 +512,7 @@ impl SphereNewton {
         let mut refused = 0;
         while t > 1e-14 {
             let trial: Vec<P3> = s.par_iter().zip(dir).map(|(p, d)| P3::from((p.coords + d * t).normalize())).collect();
-            if let Some(e) = self.energy(image, &trial)
+            if let Some(e) = self.energy_as(measure, image, &trial)
                 && e <= energy + 1e-4 * t * slope
                 && e < energy
                 && all_positive(&trial, &self.triangles)

@@ -1,0 +1,75 @@
+//! Turning over image triangles that face away from the surface, on the sphere, without ever
+//! leaving the bijective spherical triangulations.
+//!
+//! The method of Garanzha, Kaporin, Kudryavtseva, Protais, Ray & Sokolov 2021 ("Foldover-free
+//! maps in 50 lines of code"), carried to images on a surface: each image chord is projected
+//! on the surface's tangent plane under its centroid ([`Measure::Untangle`]), where a
+//! turned-over image has a negative Jacobian determinant `D`; the symmetric Dirichlet energy
+//! with `D` replaced by `χ(D, ε) = (D + √(ε² + D²)) / 2` is finite there and its minimizers turn
+//! it back. `ε` follows their schedule: it shrinks as the smallest determinant grows, so the
+//! energy tends to the distortion itself once every image is upright. The steps are the same
+//! injective Newton steps as [`SphereNewton::minimize`]: the spherical triangulation stays
+//! bijective throughout; only the images on the surface are untangled.
+
+use super::newton::{Measure, SphereImage, SphereNewton, SphereNewtonOptions};
+use crate::error::Result;
+use crate::mesh::P3;
+use crate::progress::Progress;
+
+/// What [`SphereNewton::untangle`] did.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct UntangleResult {
+    pub iterations: usize,
+    /// Turned-over images before and after.
+    pub before: usize,
+    pub after: usize,
+    /// The smallest projected Jacobian determinant at the end (positive when all upright).
+    pub min_det: f64,
+}
+
+impl SphereNewton {
+    /// Untangles the images of `s` in place, for at most `max_iterations` Newton steps; stops
+    /// as soon as every image is upright.
+    ///
+    /// # Errors
+    /// `Numerical` when a Newton system cannot be solved; `Cancelled`.
+    pub fn untangle<I: SphereImage>(
+        &self,
+        image: &I,
+        s: &mut Vec<P3>,
+        max_iterations: usize,
+        opts: &SphereNewtonOptions,
+        progress: &dyn Progress,
+    ) -> Result<UntangleResult> {
+        let count = |s: &[P3]| self.turned_over(image, s).unwrap_or(usize::MAX);
+        let before = count(s);
+        let mut r = UntangleResult { iterations: 0, before, after: before, min_det: self.min_det(image, s) };
+        let mut m = r.min_det;
+        let mut eps = (1e-8 + 0.04 * m.min(0.0).powi(2)).sqrt();
+        let mut turned = before;
+        while turned > 0 && r.iterations < max_iterations {
+            progress.check()?;
+            r.iterations += 1;
+            let measure = Measure::Untangle(eps);
+            let Some(energy) = self.energy_as(measure, image, s) else { break };
+            let (dir, slope) = self.direction(measure, image, s)?;
+            match self.line_search(measure, image, s, (&dir, slope), energy, opts) {
+                Some((next, after, _)) => {
+                    *s = next;
+                    let sigma = (1.0 - after / energy).max(0.1);
+                    m = self.min_det(image, s);
+                    let chi = 0.5 * (m + (eps * eps + m * m).sqrt());
+                    let mu = (1.0 - sigma) * chi;
+                    eps = if m < mu { 2.0 * (mu * (mu - m)).sqrt() } else { 1e-10 };
+                    turned = count(s);
+                    tracing::trace!(iteration = r.iterations, energy, after, m, eps, turned, "sphere untangle step");
+                }
+                None if eps > 1e-12 => eps *= 0.5,
+                None => break,
+            }
+        }
+        r.after = turned;
+        r.min_det = m;
+        Ok(r)
+    }
+}

@@ -41,7 +41,14 @@ fn main() {
         [("s2t", &a, &ea.points, &b, &eb.points, &pairs), ("t2s", &b, &eb.points, &a, &ea.points, &swapped)]
     {
         let t = Instant::now();
-        match sphere_pair(from, fs, to, ts, anchors, &SpherePairOptions::default(), &NoProgress) {
+        let mut o = SpherePairOptions::default();
+        if let Ok(k) = std::env::var("SURFMAP_MAX_MOVE") {
+            o.newton.max_move = k.parse().expect("SURFMAP_MAX_MOVE");
+        }
+        if let Ok(k) = std::env::var("SURFMAP_LOOSE") {
+            o.loose_iterations = k.parse().expect("SURFMAP_LOOSE");
+        }
+        match sphere_pair(from, fs, to, ts, anchors, &o, &NoProgress) {
             Ok(m) => {
                 println!("{name}: {:.2} s {}", t.elapsed().as_secs_f64(), serde_json::to_string(&m.report).unwrap());
                 let tris = to.face_indices();

@@ -29,6 +29,7 @@ use crate::optim::sym_dirichlet::{Derivatives, IDENTITY, Mat2};
 use crate::progress::Progress;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A triangle's gradient and projected Hessian in its corners' tangent steps.
 type Block = ([f64; 6], [[f64; 6]; 6]);
@@ -74,7 +75,9 @@ fn upright(images: [&Image; 3], up: &V3) -> bool {
     n.dot(up) > 0.0
 }
 
-/// The surface normal under triangle `tri`'s centroid on the sphere.
+/// The surface normal under triangle `tri`'s centroid on the sphere. (Summing the normals
+/// under the corners as well called faces of the cow's identity map turned over at sharp
+/// vertices, where a corner's face turns away from the face itself.)
 fn up_of<I: SphereImage>(image: &I, s: &[P3], tri: [u32; 3]) -> V3 {
     let c = (s[tri[0] as usize].coords + s[tri[1] as usize].coords + s[tri[2] as usize].coords).normalize();
     image.up_at(tri[0], &P3::from(c))
@@ -93,6 +96,10 @@ pub enum Measure {
     /// Jacobian determinant `D` replaced by `χ(D, ε) = (D + √(ε² + D²)) / 2` (Garanzha et al.
     /// 2021): finite on turned-over images, which it turns back ([`SphereNewton::untangle`]).
     Untangle(f64),
+    /// [`Measure::Untangle`] on the triangles marked tangled ([`SphereNewton::set_tangled`]),
+    /// [`Measure::Upright`] on the others: turned-over images are turned back while no upright
+    /// one can turn over.
+    Mixed(f64),
 }
 
 /// The chord `x` projected on the plane normal to `up`, in that plane's coordinates (`x0` at
@@ -114,21 +121,21 @@ impl Measure {
         match self {
             Measure::Upright => upright(images, up).then(|| chord_layout(images.map(|i| i.x))).flatten(),
             Measure::Loose => chord_layout(images.map(|i| i.x)),
-            Measure::Untangle(_) => projected_layout(images.map(|i| i.x), up),
+            Measure::Untangle(_) | Measure::Mixed(_) => projected_layout(images.map(|i| i.x), up),
         }
     }
 
     fn energy(self, rest: &RestTriangle, x: [[f64; 2]; 3]) -> Option<f64> {
         match self {
             Measure::Upright | Measure::Loose => rest.energy_in(x, &IDENTITY),
-            Measure::Untangle(eps) => rest.energy_eps(x, &IDENTITY, eps),
+            Measure::Untangle(eps) | Measure::Mixed(eps) => rest.energy_eps(x, &IDENTITY, eps),
         }
     }
 
     fn derivatives(self, rest: &RestTriangle, x: [[f64; 2]; 3], m: &[Mat2; 3]) -> Option<Derivatives> {
         match self {
             Measure::Upright | Measure::Loose => rest.derivatives_in(x, &IDENTITY, m),
-            Measure::Untangle(eps) => rest.derivatives_eps(x, &IDENTITY, m, eps),
+            Measure::Untangle(eps) | Measure::Mixed(eps) => rest.derivatives_eps(x, &IDENTITY, m, eps),
         }
     }
 }
@@ -175,7 +182,16 @@ pub struct SphereNewton {
     pull: Pull,
     /// Per triangle, the reference `det` of the shrink barrier (empty: no shrink barrier).
     reference: Vec<f64>,
+    /// Per triangle, whether [`Measure::Mixed`] untangles it (empty: none).
+    tangled: Vec<bool>,
+    /// The damping of the Newton systems relative to their mean diagonal (Levenberg–Marquardt),
+    /// as `f64` bits: raised when the line search cuts a step short, lowered when a full
+    /// step is taken.
+    damping: AtomicU64,
 }
+
+/// The damping's range.
+const DAMPING: (f64, f64) = (1e-8, 1e2);
 
 /// Soft goals: `weight / 2 · |p − goal|²` per pulled vertex, its 2×2 Hessian `weight · I`
 /// added into the block of one triangle around it.
@@ -219,7 +235,16 @@ impl SphereNewton {
             return Err(InputError::Invalid("triangles and rest shapes do not match".into()).into());
         }
         let (system, is_fixed) = BlockSystem::for_vertices(n_vertices, &triangles, fixed)?;
-        Ok(Self { triangles, rest, fixed: is_fixed, system, pull: Pull::default(), reference: Vec::new() })
+        Ok(Self {
+            triangles,
+            rest,
+            fixed: is_fixed,
+            system,
+            pull: Pull::default(),
+            reference: Vec::new(),
+            tangled: Vec::new(),
+            damping: AtomicU64::new(DAMPING.0.to_bits()),
+        })
     }
 
     /// Makes every triangle resist shrinking on the sphere below `fraction` of its size at
@@ -230,6 +255,11 @@ impl SphereNewton {
             .iter()
             .map(|t| fraction * det(&s[t[0] as usize], &s[t[1] as usize], &s[t[2] as usize]))
             .collect();
+    }
+
+    /// Removes the shrink barrier.
+    pub fn clear_reference(&mut self) {
+        self.reference.clear();
     }
 
     /// Pulls free vertices toward goals with `weight / 2 · |p − goal|²` each (the soft landmark
@@ -251,6 +281,28 @@ impl SphereNewton {
         }
         self.pull = Pull { weight, goals: out };
         Ok(())
+    }
+
+    /// Marks the triangles [`Measure::Mixed`] untangles (the others it keeps upright).
+    pub fn set_tangled(&mut self, tangled: &[usize]) {
+        self.tangled = vec![false; self.triangles.len()];
+        for &t in tangled {
+            if let Some(x) = self.tangled.get_mut(t) {
+                *x = true;
+            }
+        }
+    }
+
+    /// The measure triangle `t` gets under `measure`.
+    fn measure_of(&self, measure: Measure, t: usize) -> Measure {
+        match measure {
+            Measure::Mixed(_) if !self.tangled.get(t).copied().unwrap_or(false) => Measure::Upright,
+            m => m,
+        }
+    }
+
+    pub fn is_fixed(&self, v: u32) -> bool {
+        self.fixed.get(v as usize).copied().unwrap_or(false)
     }
 
     pub fn triangles(&self) -> &[[u32; 3]] {
@@ -288,6 +340,7 @@ impl SphereNewton {
                     guard += shrink_barrier(self.rest[t].area(), d0, [a, b, c]).map_or(f64::INFINITY, |g| g.0);
                 }
                 let im = tri.map(|v| &images[v as usize]);
+                let measure = self.measure_of(measure, t);
                 let e = measure.layout(im, &up_of(image, s, tri)).and_then(|(x, _)| measure.energy(&self.rest[t], x));
                 e.map_or(f64::INFINITY, |e| e + guard)
             })
@@ -320,17 +373,22 @@ impl SphereNewton {
     /// The smallest Jacobian determinant of an image projected on the surface under it
     /// (negative for a turned-over image; `-∞` where degenerate).
     pub fn min_det<I: SphereImage>(&self, image: &I, s: &[P3]) -> f64 {
-        let Some((_, images)) = Self::images(image, s) else { return f64::NEG_INFINITY };
+        self.worst(image, s).1
+    }
+
+    /// The triangle with the smallest projected Jacobian determinant, and that determinant.
+    pub fn worst<I: SphereImage>(&self, image: &I, s: &[P3]) -> (usize, f64) {
+        let Some((_, images)) = Self::images(image, s) else { return (usize::MAX, f64::NEG_INFINITY) };
         (0..self.triangles.len())
             .into_par_iter()
             .map(|t| {
                 let tri = self.triangles[t];
                 let Some((x, _)) = projected_layout(tri.map(|v| images[v as usize].x), &up_of(image, s, tri)) else {
-                    return f64::NEG_INFINITY;
+                    return (t, f64::NEG_INFINITY);
                 };
-                self.rest[t].jacobian_det(x)
+                (t, self.rest[t].jacobian_det(x))
             })
-            .reduce(|| f64::INFINITY, f64::min)
+            .reduce(|| (usize::MAX, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a })
     }
 
     /// Minimizes the energy from the bijective start `s`, in place; every accepted step keeps
@@ -404,6 +462,7 @@ impl SphereNewton {
             .into_par_iter()
             .map(|t| {
                 let tri = self.triangles[t];
+                let measure = self.measure_of(measure, t);
                 let (x, [u, w]) = measure.layout(tri.map(|v| &images[v as usize]), &up_of(image, s, tri))?;
                 let m: [Mat2; 3] = tri.map(|v| {
                     let a = &images[v as usize].d;
@@ -470,7 +529,8 @@ impl SphereNewton {
             .map(|(t, h)| (0..6).filter(|&k| self.system.dofs(t)[k] != usize::MAX).map(|k| h[k][k]).sum::<f64>())
             .sum();
         let scale = (trace / n.max(1) as f64).max(f64::MIN_POSITIVE);
-        let step = self.system.solve_shifted(&values, &rhs, 1e-8 * scale, scale)?;
+        let damping = f64::from_bits(self.damping.load(Ordering::Relaxed));
+        let step = self.system.solve_shifted(&values, &rhs, damping * scale, scale.max(damping * scale))?;
         let slope: f64 = step.iter().zip(&grad).map(|(a, g)| a * g).sum();
         let mut dir = vec![V3::zeros(); s.len()];
         let mut k = 0;
@@ -510,6 +570,7 @@ impl SphereNewton {
             t = t.min(opts.step_fraction * first);
         }
         let mut refused = 0;
+        tracing::trace!(t, first, longest, "sphere line search");
         while t > 1e-14 {
             let trial: Vec<P3> = s.par_iter().zip(dir).map(|(p, d)| P3::from((p.coords + d * t).normalize())).collect();
             if let Some(e) = self.energy_as(measure, image, &trial)
@@ -517,6 +578,18 @@ impl SphereNewton {
                 && e < energy
                 && all_positive(&trial, &self.triangles)
             {
+                // A step cut to a tenth of the Newton step or less: the quadratic model is poor
+                // (kinks where images cross the surface's edges, inversions on the sphere it
+                // does not see); damp the next systems. A full step: undamp.
+                let damping = f64::from_bits(self.damping.load(Ordering::Relaxed));
+                let next = if t <= 0.1 {
+                    (damping * 10.0).min(DAMPING.1)
+                } else if t >= 1.0 {
+                    (damping * 0.1).max(DAMPING.0)
+                } else {
+                    damping
+                };
+                self.damping.store(next.to_bits(), Ordering::Relaxed);
                 return Some((trial, e, refused));
             }
             refused += 1;

@@ -37,6 +37,8 @@ pub struct SpherePairOptions {
     pub newton: SphereNewtonOptions,
     /// Untangling steps at most.
     pub untangle_iterations: usize,
+    /// Steps at most of the first optimization, in which images may turn over.
+    pub loose_iterations: usize,
 }
 
 impl Default for SpherePairOptions {
@@ -44,6 +46,7 @@ impl Default for SpherePairOptions {
         Self {
             newton: SphereNewtonOptions { max_iterations: 100, ..SphereNewtonOptions::default() },
             untangle_iterations: 100,
+            loose_iterations: 100,
         }
     }
 }
@@ -109,19 +112,29 @@ pub fn sphere_pair(
     // 3–4. On the target, the source's triangles at the target's scale.
     let rest = scaled_rest(source, target, &tris)?;
     let held: Vec<u32> = anchors.iter().map(|a| a.0).collect();
-    let newton = SphereNewton::new(s.len(), tris.clone(), rest, &held)?;
+    let mut newton = SphereNewton::new(s.len(), tris.clone(), rest, &held)?;
     let image = OnTarget::new(SphereLocator::new(target, target_sphere), s.len());
-    let loose = newton.minimize_as(Measure::Loose, &image, &mut s, &opts.newton, progress)?;
+    let loose =
+        minimize_refreshed(&mut newton, Measure::Loose, &image, &mut s, &opts.newton, opts.loose_iterations, progress)?;
     let mut untangle = None;
     let mut turned = newton.turned_over(&image, &s).unwrap_or(usize::MAX);
     if turned > 0 {
-        let r = newton.untangle(&image, &mut s, opts.untangle_iterations, &opts.newton, progress)?;
+        let r = newton.untangle(&image, &mut s, opts.untangle_iterations, SHRINK, &opts.newton, progress)?;
         turned = r.after;
         untangle = Some(r);
     }
     let mut result = None;
     if turned == 0 {
-        result = Some(newton.minimize(&image, &mut s, &opts.newton, progress)?);
+        let iterations = opts.newton.max_iterations;
+        result = Some(minimize_refreshed(
+            &mut newton,
+            Measure::Upright,
+            &image,
+            &mut s,
+            &opts.newton,
+            iterations,
+            progress,
+        )?);
     }
     if !check(&s, &tris).is_bijective() {
         return Err(Error::Internal("the pair map lost bijectivity on the sphere".into()));
@@ -144,6 +157,57 @@ pub fn sphere_pair(
     })
 }
 
+/// Iterations between refreshes of the shrink barrier's reference.
+const REFRESH: usize = 10;
+/// A spherical triangle pays the shrink barrier below this fraction of its size at the last
+/// refresh.
+const SHRINK: f64 = 0.5;
+
+/// [`SphereNewton::minimize_as`] for `iterations` in all, in rounds of [`REFRESH`] iterations,
+/// each round's shrink barrier referred to where it starts: no spherical triangle shrinks by
+/// more than a fixed factor in one round without paying, so the Newton model sees the
+/// inversions on the sphere coming instead of the line search cutting each step short.
+fn minimize_refreshed(
+    newton: &mut SphereNewton,
+    measure: Measure,
+    image: &OnTarget<'_>,
+    s: &mut Vec<P3>,
+    opts: &SphereNewtonOptions,
+    iterations: usize,
+    progress: &dyn Progress,
+) -> Result<SphereNewtonResult> {
+    let mut total: Option<SphereNewtonResult> = None;
+    let mut done = 0;
+    while done < iterations {
+        newton.set_reference(s, SHRINK);
+        let round = SphereNewtonOptions { max_iterations: REFRESH.min(iterations - done), ..*opts };
+        let r = newton.minimize_as(measure, image, s, &round, progress)?;
+        done += round.max_iterations;
+        match &mut total {
+            None => total = Some(r),
+            Some(t) => {
+                t.iterations += r.iterations;
+                t.backtracks += r.backtracks;
+                t.converged = r.converged;
+            }
+        }
+        if r.converged {
+            break;
+        }
+    }
+    newton.clear_reference();
+    if let Some(t) = &mut total {
+        t.energy_after = newton.energy_as(measure, image, s).unwrap_or(f64::INFINITY);
+    }
+    Ok(total.unwrap_or(SphereNewtonResult {
+        iterations: 0,
+        energy_before: 0.0,
+        energy_after: 0.0,
+        backtracks: 0,
+        converged: true,
+    }))
+}
+
 /// Anchors in range, no vertex anchored twice on either side.
 fn check_anchors(anchors: &[(u32, u32)], n_source: usize, n_target: usize) -> Result<()> {
     let mut seen_s = vec![false; n_source];
@@ -164,21 +228,24 @@ fn check_anchors(anchors: &[(u32, u32)], n_source: usize, n_target: usize) -> Re
 }
 
 fn target_area(target: &Mesh) -> f64 {
-    let p = target.positions();
-    target
-        .face_indices()
+    mesh_area(target)
+}
+
+fn mesh_area(mesh: &Mesh) -> f64 {
+    let p = mesh.positions();
+    mesh.face_indices()
         .iter()
         .map(|t| 0.5 * (p[t[1] as usize] - p[t[0] as usize]).cross(&(p[t[2] as usize] - p[t[0] as usize])).norm())
         .sum()
 }
 
 /// The source's rest triangles scaled so their total area is the target's.
-fn scaled_rest(source: &Mesh, target: &Mesh, tris: &[[u32; 3]]) -> Result<Vec<RestTriangle>> {
-    let unit = rest_on_unit_sphere(source.positions(), tris)?;
-    let k = (target_area(target) / (4.0 * std::f64::consts::PI)).sqrt();
+///
+/// # Errors
+/// `Numerical` for a degenerate face.
+pub fn scaled_rest(source: &Mesh, target: &Mesh, tris: &[[u32; 3]]) -> Result<Vec<RestTriangle>> {
+    let scale = (target_area(target) / mesh_area(source)).sqrt();
     let p = source.positions();
-    let sum: f64 = unit.iter().map(RestTriangle::area).sum();
-    let scale = k * (4.0 * std::f64::consts::PI / sum).sqrt();
     tris.iter()
         .enumerate()
         .map(|(f, t)| {

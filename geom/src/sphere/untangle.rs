@@ -29,45 +29,69 @@ pub struct UntangleResult {
 
 impl SphereNewton {
     /// Untangles the images of `s` in place, for at most `max_iterations` Newton steps; stops
-    /// as soon as every image is upright.
+    /// as soon as every image is upright. Each step measures the turned-over images with the
+    /// untangling energy and the others upright ([`Measure::Mixed`]), so no image turns over
+    /// that was not already. With `shrink` positive, a shrink barrier referred to the points
+    /// every ten steps keeps the model aware of inversions on the sphere.
     ///
     /// # Errors
     /// `Numerical` when a Newton system cannot be solved; `Cancelled`.
     pub fn untangle<I: SphereImage>(
-        &self,
+        &mut self,
         image: &I,
         s: &mut Vec<P3>,
         max_iterations: usize,
+        shrink: f64,
         opts: &SphereNewtonOptions,
         progress: &dyn Progress,
     ) -> Result<UntangleResult> {
-        let count = |s: &[P3]| self.turned_over(image, s).unwrap_or(usize::MAX);
-        let before = count(s);
-        let mut r = UntangleResult { iterations: 0, before, after: before, min_det: self.min_det(image, s) };
+        let before = self.turned_over_list(image, s).unwrap_or_default();
+        let mut r = UntangleResult {
+            iterations: 0,
+            before: before.len(),
+            after: before.len(),
+            min_det: self.min_det(image, s),
+        };
         let mut m = r.min_det;
         let mut eps = (1e-8 + 0.04 * m.min(0.0).powi(2)).sqrt();
-        let mut turned = before;
-        while turned > 0 && r.iterations < max_iterations {
+        let mut tangled = before;
+        while !tangled.is_empty() && r.iterations < max_iterations {
             progress.check()?;
+            if shrink > 0.0 && r.iterations.is_multiple_of(10) {
+                self.set_reference(s, shrink);
+            }
             r.iterations += 1;
-            let measure = Measure::Untangle(eps);
+            self.set_tangled(&tangled);
+            let measure = Measure::Mixed(eps);
             let Some(energy) = self.energy_as(measure, image, s) else { break };
             let (dir, slope) = self.direction(measure, image, s)?;
-            match self.line_search(measure, image, s, (&dir, slope), energy, opts) {
-                Some((next, after, _)) => {
-                    *s = next;
-                    let sigma = (1.0 - after / energy).max(0.1);
-                    m = self.min_det(image, s);
-                    let chi = 0.5 * (m + (eps * eps + m * m).sqrt());
-                    let mu = (1.0 - sigma) * chi;
-                    eps = if m < mu { 2.0 * (mu * (mu - m)).sqrt() } else { 1e-10 };
-                    turned = count(s);
-                    tracing::trace!(iteration = r.iterations, energy, after, m, eps, turned, "sphere untangle step");
-                }
-                None if eps > 1e-12 => eps *= 0.5,
-                None => break,
-            }
+            let Some((next, after, _)) = self.line_search(measure, image, s, (&dir, slope), energy, opts) else {
+                break;
+            };
+            *s = next;
+            let sigma = (1.0 - after / energy).max(0.1);
+            m = self.min_det(image, s);
+            let chi = 0.5 * (m + (eps * eps + m * m).sqrt());
+            let mu = (1.0 - sigma) * chi;
+            eps = if m < mu { 2.0 * (mu * (mu - m)).sqrt() } else { 1e-10 };
+            tangled = self.turned_over_list(image, s).unwrap_or_default();
+            tracing::trace!(
+                iteration = r.iterations,
+                energy,
+                after,
+                m,
+                eps,
+                turned = tangled.len(),
+                "sphere untangle step"
+            );
         }
+        let (w, d) = self.worst(image, s);
+        if let Some(tri) = self.triangles().get(w) {
+            tracing::debug!(triangle = w, det = d, ?tri, fixed = ?tri.map(|v| self.is_fixed(v)), "worst after untangling");
+        }
+        self.set_tangled(&[]);
+        self.clear_reference();
+        let turned = tangled.len();
         r.after = turned;
         r.min_det = m;
         Ok(r)

@@ -171,6 +171,14 @@ impl BlockSystem {
         }
     }
 
+    /// Multiplies every diagonal entry of `values` by `factor` (Marquardt's damping,
+    /// `H + λ diag(H)` with `factor = 1 + λ`: each unknown damped on its own scale).
+    pub fn scale_diagonal(&self, values: &mut [f64], factor: f64) {
+        for &d in &self.diag {
+            values[d] *= factor;
+        }
+    }
+
     /// Solves `(H + shift·I) x = rhs`, with `H` assembled in `values`: factors numerically on the
     /// symbolic analysis and checks the relative residual.
     ///

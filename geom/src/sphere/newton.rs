@@ -184,8 +184,9 @@ pub struct SphereNewton {
     reference: Vec<f64>,
     /// Per triangle, whether [`Measure::Mixed`] untangles it (empty: none).
     tangled: Vec<bool>,
-    /// The damping of the Newton systems relative to their mean diagonal (Levenberg–Marquardt),
-    /// as `f64` bits: raised when the line search cuts a step short, lowered when a full
+    /// Marquardt's damping λ of the Newton systems (`H + λ diag(H)`: each vertex damped on the
+    /// scale of its own curvature, which differs by orders of magnitude between a thin part's
+    /// crowded points and the rest), as `f64` bits: raised when the line search cuts a step short, lowered when a full
     /// step is taken.
     damping: AtomicU64,
 }
@@ -530,7 +531,8 @@ impl SphereNewton {
             .sum();
         let scale = (trace / n.max(1) as f64).max(f64::MIN_POSITIVE);
         let damping = f64::from_bits(self.damping.load(Ordering::Relaxed));
-        let step = self.system.solve_shifted(&values, &rhs, damping * scale, scale.max(damping * scale))?;
+        self.system.scale_diagonal(&mut values, 1.0 + damping);
+        let step = self.system.solve_shifted(&values, &rhs, 1e-8 * scale, scale)?;
         let slope: f64 = step.iter().zip(&grad).map(|(a, g)| a * g).sum();
         let mut dir = vec![V3::zeros(); s.len()];
         let mut k = 0;

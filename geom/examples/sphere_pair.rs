@@ -45,8 +45,8 @@ fn main() {
         if let Ok(k) = std::env::var("SURFMAP_MAX_MOVE") {
             o.newton.max_move = k.parse().expect("SURFMAP_MAX_MOVE");
         }
-        if let Ok(k) = std::env::var("SURFMAP_LOOSE") {
-            o.loose_iterations = k.parse().expect("SURFMAP_LOOSE");
+        if let Ok(k) = std::env::var("SURFMAP_GLOBAL") {
+            o.global_iterations = k.parse().expect("SURFMAP_GLOBAL");
         }
         match sphere_pair(from, fs, to, ts, anchors, &o, &NoProgress) {
             Ok(m) => {

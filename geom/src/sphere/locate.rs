@@ -22,6 +22,9 @@ pub struct SphereLocator<'m> {
     /// does).
     face_normals: Vec<V3>,
     vertex_normals: Vec<V3>,
+    /// Per vertex, the area-weighted mean of its faces' normals (interpolated across a face, a
+    /// normal field without jumps at edges).
+    smooth_normals: Vec<V3>,
 }
 
 /// A located point: the face, its barycentric coordinates, and the surface point.
@@ -51,7 +54,21 @@ impl<'m> SphereLocator<'m> {
                 }
             }
         }
-        Self { mesh, points, face_normals, vertex_normals: best.into_iter().map(|b| b.1).collect(), tris }
+        let mut smooth = vec![V3::zeros(); mesh.n_vertices()];
+        for (t, n) in tris.iter().zip(&face_raw) {
+            for &v in t {
+                smooth[v as usize] += n;
+            }
+        }
+        let smooth_normals = smooth.iter().map(unit).collect();
+        Self {
+            mesh,
+            points,
+            face_normals,
+            vertex_normals: best.into_iter().map(|b| b.1).collect(),
+            smooth_normals,
+            tris,
+        }
     }
 
     pub fn mesh(&self) -> &Mesh {
@@ -118,6 +135,12 @@ impl<'m> SphereLocator<'m> {
         }
     }
 
+    /// The smooth normal at a location: the vertices' mean normals, interpolated.
+    pub fn smooth_normal(&self, l: &Located) -> V3 {
+        let t = self.tris[l.face as usize];
+        (0..3).map(|k| self.smooth_normals[t[k] as usize] * l.bary[k]).sum()
+    }
+
     /// The surface point of `q` in face `f` and its derivatives along `frame` (exact inside the
     /// face: the barycentric coordinates are ratios of linear functions of `q`).
     fn image_in(&self, f: u32, q: &P3, frame: &[V3; 2]) -> (P3, [V3; 2]) {
@@ -179,6 +202,10 @@ impl SphereImage for OnTarget<'_> {
     fn up_at(&self, near: u32, p: &P3) -> V3 {
         let hint = self.hints.get(near as usize).map_or(0, |h| h.load(Ordering::Relaxed));
         self.locator.normal(&self.locator.locate(p, hint))
+    }
+    fn smooth_up_at(&self, near: u32, p: &P3) -> V3 {
+        let hint = self.hints.get(near as usize).map_or(0, |h| h.load(Ordering::Relaxed));
+        self.locator.smooth_normal(&self.locator.locate(p, hint))
     }
 }
 

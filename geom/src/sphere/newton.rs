@@ -52,6 +52,11 @@ pub trait SphereImage: Sync {
     /// The surface normal under the sphere point `p` (a triangle's centroid), found from where
     /// vertex `near` was last.
     fn up_at(&self, near: u32, p: &P3) -> V3;
+    /// A normal under `p` that varies continuously (what the untangling energy projects on,
+    /// so that it has no jumps where `up_at` changes face); `up_at` by default.
+    fn smooth_up_at(&self, near: u32, p: &P3) -> V3 {
+        self.up_at(near, p)
+    }
 }
 
 /// The sphere itself: the image of a point is the point (a sphere embedding's energy).
@@ -83,15 +88,18 @@ fn up_of<I: SphereImage>(image: &I, s: &[P3], tri: [u32; 3]) -> V3 {
     image.up_at(tri[0], &P3::from(c))
 }
 
+/// The smooth normal under triangle `tri`'s centroid (see [`SphereImage::smooth_up_at`]).
+fn smooth_up_of<I: SphereImage>(image: &I, s: &[P3], tri: [u32; 3]) -> V3 {
+    let c = (s[tri[0] as usize].coords + s[tri[1] as usize].coords + s[tri[2] as usize].coords).normalize();
+    image.smooth_up_at(tri[0], &P3::from(c))
+}
+
 /// How an image triangle is measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Measure {
     /// The chord in its own plane (what the evaluator measures); a turned-over image has
     /// infinite energy, so a start without one never gets one.
     Upright,
-    /// The chord in its own plane whichever way it faces: a turned-over image has finite
-    /// energy, so a map far from its optimum can pass through them to it (untangled after).
-    Loose,
     /// The chord projected on the surface's tangent plane under its centroid, its signed
     /// Jacobian determinant `D` replaced by `χ(D, ε) = (D + √(ε² + D²)) / 2` (Garanzha et al.
     /// 2021): finite on turned-over images, which it turns back ([`SphereNewton::untangle`]).
@@ -117,24 +125,29 @@ pub fn projected_layout(x: [P3; 3], up: &V3) -> Option<([[f64; 2]; 3], [V3; 2])>
 
 impl Measure {
     /// The triangle's layout and axes as this measure sees it; `None` when refused.
-    fn layout(self, images: [&Image; 3], up: &V3) -> Option<([[f64; 2]; 3], [V3; 2])> {
+    /// `up` gives the face normal under the centroid, `smooth` the smooth one.
+    fn layout(
+        self,
+        images: [&Image; 3],
+        up: impl Fn() -> V3,
+        smooth: impl Fn() -> V3,
+    ) -> Option<([[f64; 2]; 3], [V3; 2])> {
         match self {
-            Measure::Upright => upright(images, up).then(|| chord_layout(images.map(|i| i.x))).flatten(),
-            Measure::Loose => chord_layout(images.map(|i| i.x)),
-            Measure::Untangle(_) | Measure::Mixed(_) => projected_layout(images.map(|i| i.x), up),
+            Measure::Upright => upright(images, &up()).then(|| chord_layout(images.map(|i| i.x))).flatten(),
+            Measure::Untangle(_) | Measure::Mixed(_) => projected_layout(images.map(|i| i.x), &smooth()),
         }
     }
 
     fn energy(self, rest: &RestTriangle, x: [[f64; 2]; 3]) -> Option<f64> {
         match self {
-            Measure::Upright | Measure::Loose => rest.energy_in(x, &IDENTITY),
+            Measure::Upright => rest.energy_in(x, &IDENTITY),
             Measure::Untangle(eps) | Measure::Mixed(eps) => rest.energy_eps(x, &IDENTITY, eps),
         }
     }
 
     fn derivatives(self, rest: &RestTriangle, x: [[f64; 2]; 3], m: &[Mat2; 3]) -> Option<Derivatives> {
         match self {
-            Measure::Upright | Measure::Loose => rest.derivatives_in(x, &IDENTITY, m),
+            Measure::Upright => rest.derivatives_in(x, &IDENTITY, m),
             Measure::Untangle(eps) | Measure::Mixed(eps) => rest.derivatives_eps(x, &IDENTITY, m, eps),
         }
     }
@@ -342,7 +355,9 @@ impl SphereNewton {
                 }
                 let im = tri.map(|v| &images[v as usize]);
                 let measure = self.measure_of(measure, t);
-                let e = measure.layout(im, &up_of(image, s, tri)).and_then(|(x, _)| measure.energy(&self.rest[t], x));
+                let e = measure
+                    .layout(im, || up_of(image, s, tri), || smooth_up_of(image, s, tri))
+                    .and_then(|(x, _)| measure.energy(&self.rest[t], x));
                 e.map_or(f64::INFINITY, |e| e + guard)
             })
             .sum();
@@ -384,7 +399,8 @@ impl SphereNewton {
             .into_par_iter()
             .map(|t| {
                 let tri = self.triangles[t];
-                let Some((x, _)) = projected_layout(tri.map(|v| images[v as usize].x), &up_of(image, s, tri)) else {
+                let Some((x, _)) = projected_layout(tri.map(|v| images[v as usize].x), &smooth_up_of(image, s, tri))
+                else {
                     return (t, f64::NEG_INFINITY);
                 };
                 (t, self.rest[t].jacobian_det(x))
@@ -441,6 +457,11 @@ impl SphereNewton {
                 break;
             }
             let Some((next, e, refused)) = self.line_search(measure, image, s, (&dir, slope), energy, opts) else {
+                // No step lowers the energy along this direction: damp harder and try again,
+                // and stop only when the damped direction (near the gradient's) fails too.
+                if self.raise_damping() {
+                    continue;
+                }
                 r.converged = true;
                 break;
             };
@@ -464,7 +485,11 @@ impl SphereNewton {
             .map(|t| {
                 let tri = self.triangles[t];
                 let measure = self.measure_of(measure, t);
-                let (x, [u, w]) = measure.layout(tri.map(|v| &images[v as usize]), &up_of(image, s, tri))?;
+                let (x, [u, w]) = measure.layout(
+                    tri.map(|v| &images[v as usize]),
+                    || up_of(image, s, tri),
+                    || smooth_up_of(image, s, tri),
+                )?;
                 let m: [Mat2; 3] = tri.map(|v| {
                     let a = &images[v as usize].d;
                     [[u.dot(&a[0]), u.dot(&a[1])], [w.dot(&a[0]), w.dot(&a[1])]]
@@ -543,6 +568,16 @@ impl SphereNewton {
             }
         }
         Ok((dir, slope))
+    }
+
+    /// Multiplies the damping by 100; false when it is already at its largest.
+    pub(super) fn raise_damping(&self) -> bool {
+        let d = f64::from_bits(self.damping.load(Ordering::Relaxed));
+        if d >= DAMPING.1 {
+            return false;
+        }
+        self.damping.store((d * 100.0).min(DAMPING.1).to_bits(), Ordering::Relaxed);
+        true
     }
 
     /// The accepted points, their energy and the refused trials; `None` when no step along the

@@ -66,6 +66,9 @@ impl SphereNewton {
             let Some(energy) = self.energy_as(measure, image, s) else { break };
             let (dir, slope) = self.direction(measure, image, s)?;
             let Some((next, after, _)) = self.line_search(measure, image, s, (&dir, slope), energy, opts) else {
+                if self.raise_damping() {
+                    continue;
+                }
                 break;
             };
             *s = next;

@@ -143,17 +143,19 @@ impl JobService {
     /// Parses, validates and stores one mesh.
     ///
     /// # Errors
-    /// 422 with the reader's code for a bad mesh; 413 for one over the vertex cap.
+    /// 422 with the reader's code for a bad mesh, or the checks' (`mesh_not_finite`,
+    /// `mesh_no_extent`, `zero_area_face`); 413 for one over the vertex cap.
     pub async fn upload_mesh(&self, owner: &str, bytes: Vec<u8>, hint: Option<&str>) -> Result<MeshView, ApiError> {
         let hint = parse_format(hint)?;
         let limits = MeshLimits { max_vertices: self.limits.max_vertices, max_faces: 2 * self.limits.max_vertices + 8 };
         let (bytes, parsed) = tokio::task::spawn_blocking(move || {
-            let r = geom::io::read(&bytes, &ReadOptions { limits, hint });
-            let summary = |r: &geom::io::ReadResult| geom::topology::Summary {
-                input_vertices: r.layout.as_ref().map(|l| l.n_vertices()),
-                ..geom::topology::summary(&r.mesh)
-            };
-            (bytes, r.map(|r| (r.format, summary(&r), r.warnings)))
+            // Parsed once, here: the reader, then the checks every job relies on (finite
+            // numbers, an extent, no zero-area face in a closed mesh).
+            let parsed = geom::io::read(&bytes, &ReadOptions { limits, hint }).and_then(|r| {
+                let s = geom::topology::checked_summary(&r.mesh, r.layout.as_ref().map(|l| l.n_vertices()))?;
+                Ok((r.format, s, r.warnings))
+            });
+            (bytes, parsed)
         })
         .await
         .map_err(ApiError::internal)?;
@@ -185,7 +187,18 @@ impl JobService {
                 format!("{role} mesh {id:?} is not known; upload it with POST /v1/meshes"),
             )
         })?;
-        serde_json::from_str(&m.summary).map_err(ApiError::internal)
+        // A summary stored before uploads were checked may hold nulls (overflowed numbers).
+        let unusable = |why: String| {
+            ApiError::new(
+                axum::http::StatusCode::UNPROCESSABLE_ENTITY,
+                "mesh_not_finite",
+                format!("{role} mesh {id:?} cannot be mapped: {why}; upload a scaled copy"),
+            )
+        };
+        let s: geom::topology::Summary =
+            serde_json::from_str(&m.summary).map_err(|e| unusable(format!("its summary does not read ({e})")))?;
+        s.check_finite().map_err(|e| unusable(e.to_string()))?;
+        Ok(s)
     }
 
     /// Validates a job against its meshes and queues it. Returns the job and whether it is new

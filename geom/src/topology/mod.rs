@@ -1,11 +1,14 @@
 //! Topology queries: connected components, boundary loops, Euler characteristic and genus,
-//! the summary `surfmap inspect` prints, surface points and closest-point location (BVH).
+//! the summary `surfmap inspect` prints and the checks a mesh passes before any job (`admit`),
+//! surface points and closest-point location (BVH).
 
+mod admit;
 mod components;
 mod locate;
 mod loops;
 mod surface_point;
 
+pub use admit::checked_summary;
 pub use components::{Components, PartSummary, components, parts};
 pub(crate) use locate::plane_barycentric;
 pub use locate::{Locator, Projection};

@@ -1,0 +1,38 @@
+//! What a method cannot run is refused at submission (4xx, nothing queued), not after the
+//! work: options that contradict each other, meshes the method does not take.
+
+mod common;
+use axum::body::Body;
+use axum::http::StatusCode;
+use common::*;
+use serde_json::{Value, json};
+
+async fn upload_spheres(t: &T, n: usize) -> Vec<Value> {
+    let s = geom::mesh::shapes::icosphere(3);
+    let mut ids = Vec::new();
+    for k in 0..n {
+        let f = 1.0 + 0.2 * k as f64;
+        let m = s.with_positions(s.positions().iter().map(|p| geom::mesh::P3::new(p.x * f, p.y, p.z)).collect());
+        let (_, a) = json_call(t, "POST", "/v1/meshes", geom::io::write(&m.unwrap(), geom::io::Format::Off)).await;
+        ids.push(a["id"].clone());
+    }
+    ids
+}
+
+#[tokio::test]
+async fn contradicting_quad_options_are_refused_before_queueing() {
+    let t = setup().await;
+    let ids = upload_spheres(&t, 2).await;
+    let anchors = json!([[0, 0], [1, 1], [2, 2], [3, 3]]);
+    let spec = json!({"method": "quad", "anchors": anchors,
+        "options": {"adaptive_epsilon": 0.01, "morph": {"frames": 3, "domain": "wavelet"}}});
+    let (st, e) = json_call(&t, "POST", "/v1/jobs", json!({"meshes": ids, "spec": spec}).to_string()).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("option_out_of_range")), "{e}");
+    assert!(e["message"].as_str().unwrap().contains("adaptive_epsilon"), "{e}");
+    // The wrong number of meshes for the method: 400 before anything runs.
+    let one = json!({"meshes": [ids[0]], "spec": {"method": "voronoi", "anchors": [[0, 0], [1, 1], [2, 2]]}});
+    let (st, e) = json_call(&t, "POST", "/v1/jobs", one.to_string()).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::BAD_REQUEST, Some("invalid_spec")), "{e}");
+    let (_, page) = json_call(&t, "GET", "/v1/jobs", Body::empty()).await;
+    assert_eq!(page["jobs"], json!([]), "nothing was queued");
+}

@@ -47,6 +47,7 @@ pub fn job(j: &JobRecord) -> pb::Job {
         artifacts: j.artifacts.iter().map(artifact).collect(),
         cancel_requested: j.cancel_requested,
         worker: j.lease_owner.clone().unwrap_or_default(),
+        meshes: j.meshes.clone(),
     }
 }
 

@@ -108,10 +108,23 @@ pub fn format_hint(file_name: Option<&str>) -> Option<&'static str> {
     file_name.and_then(|f| Format::from_extension(std::path::Path::new(f))).map(Format::name)
 }
 
+/// The pattern of a job id, and so of a page cursor: a lower-case hyphenated UUID.
+pub const JOB_ID_PATTERN: &str = "^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$";
+
+/// True for a string of [`JOB_ID_PATTERN`].
+pub fn is_job_id(s: &str) -> bool {
+    s.len() == 36
+        && s.bytes().enumerate().all(|(i, b)| match i {
+            8 | 13 | 18 | 23 => b == b'-',
+            _ => b.is_ascii_digit() || (b'a'..=b'f').contains(&b),
+        })
+}
+
 /// Filters of a job listing from its request fields (empty = no filter).
 ///
 /// # Errors
-/// 400 `invalid_query` for an unknown state.
+/// 400 `invalid_query` for an unknown state, method or a limit out of range; 400
+/// `invalid_cursor` for a cursor that is not a job id.
 pub fn job_filter(state: &str, method: &str, cursor: &str, limit: i64) -> Result<JobFilter, ApiError> {
     if !(1..=500).contains(&limit) && limit != 0 {
         return Err(ApiError::bad_request("invalid_query", format!("limit {limit} is outside 1..=500")));
@@ -128,6 +141,12 @@ pub fn job_filter(state: &str, method: &str, cursor: &str, limit: i64) -> Result
             JobState::parse(s).ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?,
         ),
     };
+    if !cursor.is_empty() && !is_job_id(cursor) {
+        return Err(ApiError::bad_request(
+            "invalid_cursor",
+            format!("cursor {cursor:?} is not a job id: pass the next_cursor of the previous page"),
+        ));
+    }
     let some = |s: &str| Some(s.to_string()).filter(|s| !s.is_empty());
     Ok(JobFilter { state, method: some(method), before: some(cursor), limit })
 }

@@ -21,10 +21,11 @@ pub struct ListQuery {
     /// queued | running | succeeded | failed | cancelled
     #[param(pattern = "^(queued|running|succeeded|failed|cancelled)$")]
     pub state: Option<String>,
-    /// voronoi | greedy | homology | quad
-    #[param(pattern = "^(voronoi|greedy|homology|quad)$")]
+    /// voronoi | greedy | homology | quad | spherical
+    #[param(pattern = "^(voronoi|greedy|homology|quad|spherical)$")]
     pub method: Option<String>,
-    /// `next_cursor` of the previous page.
+    /// `next_cursor` of the previous page (a job id).
+    #[param(pattern = "^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$")]
     pub cursor: Option<String>,
     /// 1 to 500; 50 by default.
     #[param(minimum = 1, maximum = 500)]
@@ -128,7 +129,7 @@ pub async fn get_job(
 }
 
 /// Jobs, newest first, with filters and cursor paging.
-#[utoipa::path(get, path = "/v1/jobs", tag = "jobs", params(ListQuery), responses((status = 200, description = "a page of jobs, newest first", body = JobPage), (status = 400, description = "a bad filter or limit", body = ErrorBody)))]
+#[utoipa::path(get, path = "/v1/jobs", tag = "jobs", params(ListQuery), responses((status = 200, description = "a page of jobs, newest first", body = JobPage), (status = 400, description = "a bad filter, limit or cursor", body = ErrorBody)))]
 pub async fn list_jobs(
     State(st): State<AppState>,
     Owner(owner): Owner,

@@ -8,7 +8,9 @@ pub mod grpc;
 pub mod grpc_decode;
 pub mod openapi;
 pub mod rest;
+pub mod serve;
 pub mod service;
+pub mod stopping;
 pub mod views;
 
 use std::time::Duration;

@@ -81,6 +81,8 @@ pub struct JobService {
     pub store: Store,
     pub blobs: BlobStore,
     pub limits: Limits,
+    /// Fires on shutdown: watch streams send the job once more and end.
+    pub stopping: crate::stopping::Stopping,
 }
 
 /// The methods a job may name, in the order the docs list them.
@@ -349,7 +351,8 @@ impl JobService {
     }
 
     /// The job every time its state, stage, progress (to 0.1%) or attempts change, ending
-    /// after a terminal state. The first item is the job as it is now.
+    /// after a terminal state, or when the server stops (after the job as it is then). The
+    /// first item is the job as it is now.
     pub fn watch(&self, owner: String, first: JobRecord) -> impl Stream<Item = JobRecord> + Send + 'static + use<> {
         struct S {
             svc: JobService,
@@ -368,11 +371,19 @@ impl JobService {
                 let job = match s.first.take() {
                     Some(j) => j,
                     None => {
-                        tokio::time::sleep(s.svc.limits.watch_interval).await;
-                        match s.svc.store.get_job(&s.owner, &s.id).await {
+                        let stopping = tokio::select! {
+                            () = tokio::time::sleep(s.svc.limits.watch_interval) => false,
+                            () = s.svc.stopping.fired() => true,
+                        };
+                        let job = match s.svc.store.get_job(&s.owner, &s.id).await {
                             Ok(Some(j)) => j,
                             _ => return None,
+                        };
+                        if stopping {
+                            s.done = true;
+                            return Some((job, s));
                         }
+                        job
                     }
                 };
                 let key =

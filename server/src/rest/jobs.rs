@@ -164,9 +164,10 @@ pub async fn cancel_job(
 }
 
 /// Server-sent events: one `job` event (a JobView) per change of state, stage or progress;
-/// the stream ends after a terminal state.
+/// the stream ends after a terminal state. When the server shuts down it sends the job once
+/// more, then `event: shutdown` (`{code: "shutting_down", message}`), and ends: reconnect.
 #[utoipa::path(get, path = "/v1/jobs/{id}/events", tag = "jobs", params(("id" = String, Path)),
-    responses((status = 200, content_type = "text/event-stream", description = "`event: job` with a JobView as data"),
+    responses((status = 200, content_type = "text/event-stream", description = "`event: job` with a JobView as data; `event: shutdown` last when the server stops"),
         (status = 404, description = "unknown job", body = ErrorBody)))]
 pub async fn job_events(
     State(st): State<AppState>,
@@ -178,5 +179,10 @@ pub async fn job_events(
         let ev = Event::default().event("job");
         Ok(ev.json_data(job_view(&job)).unwrap_or_else(|_| Event::default().event("error")))
     });
-    Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
+    let stopping = st.service.stopping.clone();
+    let last = futures::stream::once(async move { stopping.is_set() }).filter_map(|stopping| async move {
+        let body = ErrorBody { code: "shutting_down".into(), message: "the server is stopping; reconnect".into() };
+        stopping.then(|| Ok(Event::default().event("shutdown").json_data(body).unwrap_or_default()))
+    });
+    Ok(Sse::new(stream.chain(last)).keep_alive(KeepAlive::default()))
 }

@@ -24,7 +24,7 @@ pub async fn setup_with(tokens: &[String]) -> T {
     let blobs = BlobStore::open(dir.path()).unwrap();
     let limits = Limits { max_body_bytes: 1 << 20, ..Limits::default() };
     let state = AppState {
-        service: JobService { store: store.clone(), blobs: blobs.clone(), limits },
+        service: JobService { store: store.clone(), blobs: blobs.clone(), limits, stopping: Default::default() },
         auth: Auth::new(tokens),
     };
     let worker = Worker { store, blobs, config: WorkerConfig::default() };

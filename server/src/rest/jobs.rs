@@ -138,6 +138,9 @@ pub async fn list_jobs(
     if q.state.as_deref() == Some("") || q.method.as_deref() == Some("") {
         return Err(ApiError::bad_request("invalid_query", "state and method, when given, must not be empty"));
     }
+    if q.cursor.as_deref() == Some("") {
+        return Err(ApiError::bad_request("invalid_cursor", "cursor, when given, is the next_cursor of a page"));
+    }
     let filter = job_filter(
         q.state.as_deref().unwrap_or_default(),
         q.method.as_deref().unwrap_or_default(),

@@ -88,6 +88,16 @@ fn missing_file_and_bad_arguments_exit_2() {
     let bad = write(&d, "b.json", b"{\"anchor\": 3}");
     let o = surfmap(&["metrics", c, c, c, "--anchors", bad.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
+    // A source whose areas overflow: refused, not a report of inf and NaN.
+    let big = write(
+        &d,
+        "big.obj",
+        b"v 1e200 0 0\nv -1e200 0 0\nv 0 1e200 0\nv 0 0 1e200\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+    );
+    let o =
+        surfmap(&["metrics", big.to_str().unwrap(), big.to_str().unwrap(), big.to_str().unwrap(), "--samples", "100"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("[mesh_not_finite]"));
     // Mapped mesh with other connectivity.
     let horse = mesh("horse.off");
     let o = surfmap(&["metrics", c, c, horse.to_str().unwrap(), "--samples", "100"]);

@@ -36,3 +36,30 @@ async fn contradicting_quad_options_are_refused_before_queueing() {
     let (_, page) = json_call(&t, "GET", "/v1/jobs", Body::empty()).await;
     assert_eq!(page["jobs"], json!([]), "nothing was queued");
 }
+
+/// Feature curves whose vertex lists no mesh of these summaries can hold: refused at
+/// submission, not when the job runs.
+#[tokio::test]
+async fn feature_curves_out_of_range_or_repeating_are_refused_before_queueing() {
+    let t = setup().await;
+    let ids = upload_spheres(&t, 2).await;
+    for (source, target, what) in [
+        (json!([0, 99999]), json!([0, 1]), "out of range"),
+        (json!([0]), json!([0, 1]), "at least 2"),
+        (json!([0, 1, 0, 2]), json!([0, 1, 2, 3]), "repeats vertex 0"),
+    ] {
+        let spec =
+            json!({"method": "homology", "anchors": [[5, 5]], "features": [{"source": source, "target": target}]});
+        let body = json!({"source": ids[0], "target": ids[1], "spec": spec}).to_string();
+        let (st, e) = json_call(&t, "POST", "/v1/jobs", body).await;
+        assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("invalid_features")), "{e}");
+        assert!(e["message"].as_str().unwrap().contains(what), "{what}: {e}");
+    }
+    // A closed curve (first vertex repeated last) passes these checks.
+    let spec = json!({"method": "homology", "anchors": [[5, 5]], "features": [{"source": [0, 1, 2, 0], "target": [0, 1, 2, 0]}]});
+    let body = json!({"source": ids[0], "target": ids[1], "spec": spec}).to_string();
+    let (_, e) = json_call(&t, "POST", "/v1/jobs", body).await;
+    assert_ne!(e["code"].as_str(), Some("invalid_features"), "{e}");
+    let (_, page) = json_call(&t, "GET", "/v1/jobs", Body::empty()).await;
+    assert!(page["jobs"].as_array().unwrap().len() <= 1, "only the closed curve's job may be queued");
+}

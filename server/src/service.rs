@@ -174,7 +174,9 @@ impl JobService {
             // numbers, an extent, no zero-area face in a closed mesh).
             let parsed = geom::io::read(&bytes, &ReadOptions { limits, hint }).and_then(|r| {
                 let s = geom::topology::checked_summary(&r.mesh, r.layout.as_ref().map(|l| l.n_vertices()))?;
-                Ok((r.format, s, r.warnings))
+                // The attributes a job's `transfer` may name, checked at submission.
+                let names = geom::pipeline::attribute_names(&r.mesh, r.layout.as_ref());
+                Ok((r.format, geom::topology::Summary { attribute_names: Some(names), ..s }, r.warnings))
             });
             (bytes, parsed)
         })

@@ -63,3 +63,23 @@ async fn feature_curves_out_of_range_or_repeating_are_refused_before_queueing() 
     let (_, page) = json_call(&t, "GET", "/v1/jobs", Body::empty()).await;
     assert!(page["jobs"].as_array().unwrap().len() <= 1, "only the closed curve's job may be queued");
 }
+
+/// A `transfer` of an attribute the source does not have: refused at submission (the source's
+/// summary records its attributes), not after the map is built.
+#[tokio::test]
+async fn a_transfer_of_a_missing_attribute_is_refused_before_queueing() {
+    let t = setup().await;
+    let ids = upload_spheres(&t, 2).await;
+    let (_, m) = json_call(&t, "GET", "/v1/jobs", Body::empty()).await;
+    assert_eq!(m["jobs"], json!([]));
+    for (transfer, missing) in [(json!(["TEXCOORD_0"]), "TEXCOORD_0"), (json!(["COLOR_0"]), "COLOR_0")] {
+        let spec = json!({"method": "voronoi", "anchors": [[0, 0], [5, 5], [9, 9]], "options": {"transfer": transfer}});
+        let body = json!({"source": ids[0], "target": ids[1], "spec": spec}).to_string();
+        let (st, e) = json_call(&t, "POST", "/v1/jobs", body).await;
+        assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("invalid_argument")), "{e}");
+        let msg = e["message"].as_str().unwrap();
+        assert!(msg.contains(missing) && msg.contains("no attributes"), "{e}");
+    }
+    let (_, page) = json_call(&t, "GET", "/v1/jobs", Body::empty()).await;
+    assert_eq!(page["jobs"], json!([]), "nothing was queued");
+}

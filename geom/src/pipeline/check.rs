@@ -26,20 +26,30 @@ impl JobSpec {
                 .into()),
             }
         };
-        match self {
+        let transfer = match self {
             JobSpec::Voronoi(s) | JobSpec::Greedy(s) => {
                 let (a, b) = pair(summaries.len())?;
-                s.check(self.method(), a, b).map(|_| ())
+                s.check(self.method(), a, b)?;
+                &s.options.transfer
             }
             JobSpec::Homology(s) => {
                 let (a, b) = pair(summaries.len())?;
-                s.check(a, b).map(|_| ())
+                s.check(a, b)?;
+                &s.options.transfer
             }
-            JobSpec::Quad(s) => s.check(summaries).map(|_| ()),
+            JobSpec::Quad(s) => return s.check(summaries).map(|_| ()),
             JobSpec::Spherical(s) => {
                 let (a, b) = pair(summaries.len())?;
-                s.check(a, b).map(|_| ())
+                s.check(a, b)?;
+                &s.options.transfer
             }
+        };
+        // The attributes `transfer` carries, when the source's summary records them.
+        match summaries.first().and_then(|s| s.attribute_names.as_deref()) {
+            Some(names) if !transfer.is_empty() => {
+                super::transfer_output::check_names(&super::transfer_output::parse(transfer)?, names)
+            }
+            _ => Ok(()),
         }
     }
 }

@@ -42,6 +42,10 @@ pub struct Summary {
     /// vertex ids a job names on it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub input_vertices: Option<usize>,
+    /// The file's vertex attributes by glTF name (`TEXCOORD_0`, `COLOR_0`...), as a job's
+    /// `transfer` names them; absent when not recorded (checked at run time then).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub attribute_names: Option<Vec<String>>,
 }
 
 impl Summary {
@@ -83,6 +87,7 @@ pub fn summary(mesh: &Mesh) -> Summary {
         bbox_diagonal: (hi - lo).norm(),
         area: mesh.area(),
         input_vertices: None,
+        attribute_names: None,
     }
 }
 

@@ -15,10 +15,25 @@ fn read(path: &Path) -> Result<io::ReadResult> {
     })
 }
 
+/// A mesh a job can run on: read, then the checks the server's upload makes (finite numbers,
+/// an extent, no zero-area face in a closed mesh), naming the file.
+fn read_checked(path: &Path) -> Result<(io::ReadResult, geom::topology::Summary)> {
+    let r = read(path)?;
+    match geom::topology::checked_summary(&r.mesh, None) {
+        Ok(s) => Ok((r, s)),
+        Err(Error::Input(InputError::NotFinite(m))) => {
+            Err(InputError::NotFinite(format!("{}: {m}", path.display())).into())
+        }
+        Err(Error::Input(InputError::NoExtent(m))) => {
+            Err(InputError::NoExtent(format!("{}: {m}", path.display())).into())
+        }
+        Err(e) => Err(e),
+    }
+}
+
 /// `surfmap inspect MESH`.
 pub fn inspect(path: &Path) -> Result<String> {
-    let r = read(path)?;
-    let s = geom::topology::summary(&r.mesh);
+    let (r, s) = read_checked(path)?;
     let mut v = serde_json::to_value(&s).map_err(|e| Error::Internal(e.to_string()))?;
     v["format"] = json!(r.format);
     if s.components > 1 {
@@ -111,8 +126,10 @@ pub fn metrics(
     samples: usize,
     seed: u64,
 ) -> Result<String> {
-    let s = read(source)?.mesh;
-    let t = read(target)?.mesh;
+    // The pair passes the checks a map's inputs pass (finite numbers in the report); the
+    // mapped mesh is measured as it is (a collapsed face is a result to report).
+    let s = read_checked(source)?.0.mesh;
+    let t = read_checked(target)?.0.mesh;
     let m = read(mapped)?.mesh;
     let anchors = anchors.map(read_anchors).transpose()?;
     let gt = gt.map(read_gt).transpose()?;
@@ -173,7 +190,7 @@ pub fn map(
         }
         (None, None) => return Err(geom::InputError::Spec("give --anchors or --spec".into()).into()),
     };
-    let (s, t) = (read(source)?, read(target)?);
+    let (s, t) = (read_checked(source)?.0, read_checked(target)?.0);
     let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
     let (report, artifacts) =
         geom::pipeline::run_with_layouts(&spec, &[s.mesh, t.mesh], &[s.layout, t.layout], &mut progress)?;
@@ -185,8 +202,12 @@ pub fn remesh(meshes: &[std::path::PathBuf], spec: &Path, out: &Path) -> Result<
     let bytes =
         std::fs::read(spec).map_err(|e| geom::InputError::Invalid(format!("cannot read {}: {e}", spec.display())))?;
     let spec = geom::pipeline::JobSpec::from_json(&bytes)?;
-    let (models, layouts): (Vec<_>, Vec<_>) =
-        meshes.iter().map(|m| read(m).map(|r| (r.mesh, r.layout))).collect::<Result<Vec<_>>>()?.into_iter().unzip();
+    let (models, layouts): (Vec<_>, Vec<_>) = meshes
+        .iter()
+        .map(|m| read_checked(m).map(|(r, _)| (r.mesh, r.layout)))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .unzip();
     let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
     let (report, artifacts) = geom::pipeline::run_with_layouts(&spec, &models, &layouts, &mut progress)?;
     finish(&progress, out, &artifacts, &report)

@@ -50,6 +50,11 @@ fn malformed_inputs_exit_2_with_a_named_problem() {
         ("duplicate.off", b"OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 1 2 0\n".to_vec(), "duplicate_face"),
         ("noface.obj", b"v 0 0 0\nv 1 0 0\n".to_vec(), "no_faces"),
         ("huge_count.off", b"OFF\n99999999999 1 0\n".to_vec(), "too_large"),
+        // Meshes that read but cannot be mapped: coordinates whose areas overflow, no extent,
+        // a zero-area face in a closed mesh (the server refuses the same at upload).
+        ("overflow.obj", b"v 1e200 0 0\nv -1e200 0 0\nv 0 1e200 0\nv 0 0 1e200\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n".to_vec(), "mesh_not_finite"),
+        ("one_point.obj", b"v 1 1 1\nv 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n".to_vec(), "mesh_no_extent"),
+        ("flat_face.obj", b"v 0 0 0\nv 2 0 0\nv 1 0 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n".to_vec(), "zero_area_face"),
         // glTF: a GLB header promising more bytes than the file, a Draco-only document, an
         // accessor reading past its buffer.
         ("lying.glb", { let mut b = b"glTF".to_vec(); b.extend_from_slice(&2u32.to_le_bytes()); b.extend_from_slice(&5000u32.to_le_bytes()); b.extend_from_slice(&[0u8; 20]); b }, "lying_count"),
@@ -83,6 +88,16 @@ fn missing_file_and_bad_arguments_exit_2() {
     let bad = write(&d, "b.json", b"{\"anchor\": 3}");
     let o = surfmap(&["metrics", c, c, c, "--anchors", bad.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
+    // A source whose areas overflow: refused, not a report of inf and NaN.
+    let big = write(
+        &d,
+        "big.obj",
+        b"v 1e200 0 0\nv -1e200 0 0\nv 0 1e200 0\nv 0 0 1e200\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+    );
+    let o =
+        surfmap(&["metrics", big.to_str().unwrap(), big.to_str().unwrap(), big.to_str().unwrap(), "--samples", "100"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("[mesh_not_finite]"));
     // Mapped mesh with other connectivity.
     let horse = mesh("horse.off");
     let o = surfmap(&["metrics", c, c, horse.to_str().unwrap(), "--samples", "100"]);

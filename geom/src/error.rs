@@ -106,6 +106,18 @@ pub enum InputError {
     /// A file requires an extension this service does not implement (named).
     #[error("the file requires the extension {0}, which surfmap does not read (export without it)")]
     UnsupportedExtension(String),
+    /// Coordinates so large that lengths, areas or their products overflow (the message names
+    /// the vertex or the quantity).
+    #[error("mesh numbers not finite: {0}")]
+    NotFinite(String),
+    /// Every vertex at one point, or every face flat onto a line: the mesh has no surface.
+    #[error("mesh has no extent: {0}")]
+    NoExtent(String),
+    /// A closed mesh with a face of zero area (collinear corners): no map can place it.
+    #[error(
+        "face {face} of the closed mesh has zero area (area {area:e}, largest face {largest:e}): its corners are collinear; repair or remove it"
+    )]
+    ZeroAreaFace { face: usize, area: f64, largest: f64 },
 }
 
 impl InputError {
@@ -138,6 +150,9 @@ impl InputError {
             InputError::OptionRange(_) => "option_out_of_range",
             InputError::OverBudget { .. } => "over_budget",
             InputError::UnsupportedExtension(_) => "unsupported_extension",
+            InputError::NotFinite(_) => "mesh_not_finite",
+            InputError::NoExtent(_) => "mesh_no_extent",
+            InputError::ZeroAreaFace { .. } => "zero_area_face",
         }
     }
 }

@@ -16,3 +16,7 @@ pub const PLANAR_DEGENERATE_REL: f64 = 1e-14;
 /// A planar triangle with |signed area| (twice the area) at or below this times its longest edge
 /// squared is degenerate: its three corners are collinear up to rounding.
 pub const PLANAR_COLLINEAR_REL: f64 = 1e-12;
+/// Largest |coordinate| a mesh may have: lengths, areas and products of up to four lengths
+/// (squared areas, Heron's formula, squared cotangent weights) stay finite in f64
+/// ((2·√3·1e75)^4 ≈ 2e302 < 1.8e308).
+pub const MAX_COORDINATE: f64 = 1e75;

@@ -1,5 +1,6 @@
 //! Property tests: mutated bytes of real files, fed to every reader, never panic. Each input
-//! either reads into a valid mesh or fails with a typed input error.
+//! either reads into a valid mesh or fails with a typed input error; a mesh read passes the
+//! upload checks with finite summary numbers or is refused as input.
 
 mod common;
 use geom::io::{self, Format, ReadOptions};
@@ -100,6 +101,14 @@ proptest! {
                 prop_assert!(r.mesh.n_faces() > 0);
                 prop_assert!(r.mesh.positions().iter().all(|p| p.coords.iter().all(|c| c.is_finite())));
                 let _ = geom::topology::summary(&r.mesh);
+                // The upload checks accept it with finite numbers, or refuse it as bad input.
+                match geom::topology::checked_summary(&r.mesh, None) {
+                    Ok(s) => {
+                        let nums = s.bbox.iter().flatten().chain([&s.bbox_diagonal, &s.area]);
+                        prop_assert!(nums.clone().all(|v| v.is_finite()), "{s:?}");
+                    }
+                    Err(e) => prop_assert!(e.is_input(), "non-input error {e:?}"),
+                }
             }
             Err(e) => prop_assert!(e.is_input(), "non-input error {e:?}"),
         }

@@ -38,7 +38,7 @@ impl Auth {
     /// # Errors
     /// 401 when the request may not.
     pub fn metrics_allowed(&self, authorization: Option<&str>) -> Result<(), ApiError> {
-        let presented = authorization.and_then(|h| h.strip_prefix("Bearer ")).map(str::trim);
+        let presented = authorization.and_then(bearer_token);
         match (&self.metrics, presented) {
             (Some(k), Some(t)) if k[..] == Sha256::digest(t.as_bytes())[..] => Ok(()),
             (Some(_), _) => Err(ApiError::unauthorized()),
@@ -59,12 +59,19 @@ impl Auth {
         if !self.enabled() {
             return Ok(String::new());
         }
-        let token =
-            authorization.and_then(|h| h.strip_prefix("Bearer ")).map(str::trim).ok_or_else(ApiError::unauthorized)?;
+        let token = authorization.and_then(bearer_token).ok_or_else(ApiError::unauthorized)?;
         let h = Sha256::digest(token.as_bytes());
         // Compare hashes, not tokens: no early exit on a prefix of a secret.
         self.owners.iter().find(|(k, _)| k[..] == h[..]).map(|(_, o)| o.clone()).ok_or_else(ApiError::unauthorized)
     }
+}
+
+/// The token of an `Authorization: Bearer TOKEN` value; the scheme name is case-insensitive
+/// (RFC 9110 §11.1), so `bearer T` and `BEARER T` present `T` too.
+pub fn bearer_token(authorization: &str) -> Option<&str> {
+    let (scheme, token) = authorization.trim_start().split_once([' ', '\t'])?;
+    let token = token.trim();
+    (scheme.eq_ignore_ascii_case("bearer") && !token.is_empty()).then_some(token)
 }
 
 #[cfg(test)]
@@ -79,6 +86,13 @@ mod tests {
         assert!(!x.is_empty() && x != y);
         assert_eq!(a.owner(Some("Bearer gamma")).unwrap_err().code, "unauthorized");
         assert_eq!(a.owner(None).unwrap_err().code, "unauthorized");
+        // The scheme name is case-insensitive; the token is not.
+        for h in ["bearer alpha", "BEARER alpha", "Bearer   alpha ", "bEaReR\talpha"] {
+            assert_eq!(a.owner(Some(h)).unwrap(), x, "{h:?}");
+        }
+        for h in ["Bearer ALPHA", "Basic alpha", "Bearer", "Bearer ", "Beareralpha", "alpha"] {
+            assert_eq!(a.owner(Some(h)).unwrap_err().code, "unauthorized", "{h:?}");
+        }
     }
 
     #[test]

@@ -47,6 +47,7 @@ pub fn job(j: &JobRecord) -> pb::Job {
         artifacts: j.artifacts.iter().map(artifact).collect(),
         cancel_requested: j.cancel_requested,
         worker: j.lease_owner.clone().unwrap_or_default(),
+        meshes: j.meshes.clone(),
     }
 }
 
@@ -108,7 +109,17 @@ impl Surfmap for GrpcApi {
         let o = owner(&self.state, &req)?;
         let first = self.state.service.get(&o, &req.into_inner().id).await?;
         let s = self.state.service.watch(o, first).map(|j| Ok(job(&j)));
-        Ok(Response::new(Box::pin(s)))
+        // On shutdown: the job once more, then UNAVAILABLE with the code `shutting_down`.
+        let stopping = self.state.service.stopping.clone();
+        let last = futures::stream::once(async move { stopping.is_set() }).filter_map(|stopping| async move {
+            let e = crate::error::ApiError::new(
+                axum::http::StatusCode::SERVICE_UNAVAILABLE,
+                "shutting_down",
+                "the server is stopping; reconnect",
+            );
+            stopping.then(|| Err(Status::from(e)))
+        });
+        Ok(Response::new(Box::pin(s.chain(last))))
     }
 
     async fn list_artifacts(

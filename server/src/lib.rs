@@ -5,9 +5,12 @@
 pub mod auth;
 pub mod error;
 pub mod grpc;
+pub mod grpc_decode;
 pub mod openapi;
 pub mod rest;
+pub mod serve;
 pub mod service;
+pub mod stopping;
 pub mod views;
 
 use std::time::Duration;
@@ -43,7 +46,10 @@ pub fn app(state: AppState) -> axum::Router {
     }
     // tonic's router brings a fallback (gRPC `unimplemented`); replace it with the JSON 404
     // so the merged router has exactly one.
-    rest::router(state).merge(routes.into_axum_router().fallback(rest::not_found))
+    let grpc = routes
+        .into_axum_router()
+        .layer(axum::middleware::map_response(grpc_decode::decode_failure_is_invalid_argument));
+    rest::router(state).merge(grpc.fallback(rest::not_found))
 }
 
 /// Requeues expired leases every `period` until `shutdown`.

@@ -65,6 +65,14 @@ struct Args {
     /// process is capped at it (an allocation beyond it fails the job, not the service).
     #[arg(long, env = "SURFMAP_JOB_MEMORY_MB", default_value_t = 8192)]
     job_memory_mb: u64,
+    /// A connection's first request, and every HTTP/1 request's headers, must arrive within
+    /// this many seconds, or the connection is closed.
+    #[arg(long, env = "SURFMAP_HEADER_READ_TIMEOUT_SECS", default_value_t = 10.0)]
+    header_read_timeout_secs: f64,
+    /// Open connections at most (at the limit the oldest connection with no request in flight
+    /// is closed to admit a new one). Capped below the process's descriptor limit.
+    #[arg(long, env = "SURFMAP_MAX_CONNECTIONS", default_value_t = 4096)]
+    max_connections: usize,
 }
 
 fn main() -> std::process::ExitCode {
@@ -74,6 +82,16 @@ fn main() -> std::process::ExitCode {
 async fn run(a: Args) -> anyhow::Result<()> {
     if !(a.lease_secs.is_finite() && a.lease_secs > 0.0) || a.max_attempts < 1 {
         anyhow::bail!("--lease-secs must be positive and --max-attempts at least 1");
+    }
+    if !(a.header_read_timeout_secs.is_finite() && a.header_read_timeout_secs > 0.0) || a.max_connections < 1 {
+        anyhow::bail!("--header-read-timeout-secs must be positive and --max-connections at least 1");
+    }
+    // Connections must run out before descriptors do (the store, blobs and jobs need some).
+    let descriptors = rlimit::increase_nofile_limit(u64::MAX).unwrap_or(1024);
+    let max_connections =
+        a.max_connections.min(usize::try_from(descriptors.saturating_sub(256)).unwrap_or(usize::MAX).max(16));
+    if max_connections < a.max_connections {
+        tracing::warn!(max_connections, descriptors, "--max-connections lowered to fit the descriptor limit");
     }
     surfmap_worker::telemetry::prometheus();
     let store = surfmap_store::Store::connect(&a.database_url).await?;
@@ -87,7 +105,9 @@ async fn run(a: Args) -> anyhow::Result<()> {
         job_memory_bytes: a.job_memory_mb.saturating_mul(1 << 20),
         ..Limits::default()
     };
-    let service = JobService { store: store.clone(), blobs: blobs.clone(), limits };
+    let (tx, rx) = tokio::sync::watch::channel(false);
+    let stopping = surfmap_server::stopping::Stopping::new(rx.clone());
+    let service = JobService { store: store.clone(), blobs: blobs.clone(), limits, stopping };
     let auth = Auth::new(&a.api_tokens).with_metrics_token(a.metrics_token.as_deref());
     let state = AppState { service, auth };
     let listener = tokio::net::TcpListener::bind(&a.listen).await?;
@@ -96,7 +116,6 @@ async fn run(a: Args) -> anyhow::Result<()> {
     std::io::stdout().flush()?;
     tracing::info!(%addr, store = store.dialect(), auth = state.auth.enabled(), "serving REST and gRPC");
 
-    let (tx, rx) = tokio::sync::watch::channel(false);
     let lease = Duration::from_secs_f64(a.lease_secs);
     let mut tasks = Vec::new();
     tasks.push(tokio::spawn(surfmap_server::janitor(
@@ -122,13 +141,17 @@ async fn run(a: Args) -> anyhow::Result<()> {
         tasks.push(tokio::spawn(async move { w.run(rx).await }));
     }
     tracing::info!(workers = n, "in-process workers started");
-    axum::serve(listener, surfmap_server::app(state))
-        .with_graceful_shutdown(async move {
-            surfmap_worker::shutdown_signal().await;
-            tracing::info!("shutdown requested: no new requests or jobs");
-            let _ = tx.send(true);
-        })
-        .await?;
+    let cfg = surfmap_server::serve::ServeConfig {
+        header_read_timeout: Duration::from_secs_f64(a.header_read_timeout_secs),
+        max_connections,
+        grace: Duration::from_secs(a.shutdown_grace_secs),
+    };
+    let signal = async move {
+        surfmap_worker::shutdown_signal().await;
+        tracing::info!("shutdown requested: no new requests or jobs; open streams end");
+        let _ = tx.send(true);
+    };
+    surfmap_server::serve::serve(listener, surfmap_server::app(state), cfg, signal).await?;
     for t in tasks {
         let _ = t.await;
     }

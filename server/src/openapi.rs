@@ -1,4 +1,5 @@
-//! The OpenAPI document, derived from the handlers' annotations (utoipa).
+//! The OpenAPI document, derived from the handlers' annotations (utoipa), with the bearer
+//! security scheme and the 401 answers of the routes that take a token added here.
 
 use crate::error::ErrorBody;
 use crate::rest::{artifacts, jobs, meshes, ops};
@@ -42,3 +43,31 @@ use crate::views::{
     ))
 )]
 pub struct ApiDoc;
+
+/// The document as served: every `/v1` route (and `/metrics`) takes a bearer token and may
+/// answer 401. With tokens configured the token is required; without, it is optional (`{}`
+/// among the requirements: the server then ignores it).
+pub fn document(auth_required: bool) -> serde_json::Value {
+    use serde_json::json;
+    use utoipa::OpenApi;
+    let mut doc = serde_json::to_value(ApiDoc::openapi()).unwrap_or_default();
+    doc["components"]["securitySchemes"]["bearer"] = json!({
+        "type": "http", "scheme": "bearer",
+        "description": "a token of `--api-token`; the owner of the jobs and meshes it sees (`--metrics-token` for /metrics)"
+    });
+    let security = if auth_required { json!([{"bearer": []}]) } else { json!([{"bearer": []}, {}]) };
+    let unauthorized = json!({
+        "description": "missing or unknown bearer token",
+        "content": {"application/json": {"schema": {"$ref": "#/components/schemas/ErrorBody"}}}
+    });
+    if let Some(paths) = doc.get_mut("paths").and_then(serde_json::Value::as_object_mut) {
+        for (path, item) in paths.iter_mut().filter(|(p, _)| p.starts_with("/v1/") || *p == "/metrics") {
+            let ops = item.as_object_mut().into_iter().flat_map(|m| m.iter_mut());
+            for (_, op) in ops.filter(|(m, _)| ["get", "post", "put", "patch", "delete"].contains(&m.as_str())) {
+                op["security"] = if path == "/metrics" { json!([{"bearer": []}, {}]) } else { security.clone() };
+                op["responses"]["401"] = unauthorized.clone();
+            }
+        }
+    }
+    doc
+}

@@ -81,6 +81,8 @@ pub struct JobService {
     pub store: Store,
     pub blobs: BlobStore,
     pub limits: Limits,
+    /// Fires on shutdown: watch streams send the job once more and end.
+    pub stopping: crate::stopping::Stopping,
 }
 
 /// The methods a job may name, in the order the docs list them.
@@ -108,10 +110,23 @@ pub fn format_hint(file_name: Option<&str>) -> Option<&'static str> {
     file_name.and_then(|f| Format::from_extension(std::path::Path::new(f))).map(Format::name)
 }
 
+/// The pattern of a job id, and so of a page cursor: a lower-case hyphenated UUID.
+pub const JOB_ID_PATTERN: &str = "^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$";
+
+/// True for a string of [`JOB_ID_PATTERN`].
+pub fn is_job_id(s: &str) -> bool {
+    s.len() == 36
+        && s.bytes().enumerate().all(|(i, b)| match i {
+            8 | 13 | 18 | 23 => b == b'-',
+            _ => b.is_ascii_digit() || (b'a'..=b'f').contains(&b),
+        })
+}
+
 /// Filters of a job listing from its request fields (empty = no filter).
 ///
 /// # Errors
-/// 400 `invalid_query` for an unknown state.
+/// 400 `invalid_query` for an unknown state, method or a limit out of range; 400
+/// `invalid_cursor` for a cursor that is not a job id.
 pub fn job_filter(state: &str, method: &str, cursor: &str, limit: i64) -> Result<JobFilter, ApiError> {
     if !(1..=500).contains(&limit) && limit != 0 {
         return Err(ApiError::bad_request("invalid_query", format!("limit {limit} is outside 1..=500")));
@@ -128,6 +143,12 @@ pub fn job_filter(state: &str, method: &str, cursor: &str, limit: i64) -> Result
             JobState::parse(s).ok_or_else(|| ApiError::bad_request("invalid_query", format!("unknown state {s:?}")))?,
         ),
     };
+    if !cursor.is_empty() && !is_job_id(cursor) {
+        return Err(ApiError::bad_request(
+            "invalid_cursor",
+            format!("cursor {cursor:?} is not a job id: pass the next_cursor of the previous page"),
+        ));
+    }
     let some = |s: &str| Some(s.to_string()).filter(|s| !s.is_empty());
     Ok(JobFilter { state, method: some(method), before: some(cursor), limit })
 }
@@ -143,17 +164,21 @@ impl JobService {
     /// Parses, validates and stores one mesh.
     ///
     /// # Errors
-    /// 422 with the reader's code for a bad mesh; 413 for one over the vertex cap.
+    /// 422 with the reader's code for a bad mesh, or the checks' (`mesh_not_finite`,
+    /// `mesh_no_extent`, `zero_area_face`); 413 for one over the vertex cap.
     pub async fn upload_mesh(&self, owner: &str, bytes: Vec<u8>, hint: Option<&str>) -> Result<MeshView, ApiError> {
         let hint = parse_format(hint)?;
         let limits = MeshLimits { max_vertices: self.limits.max_vertices, max_faces: 2 * self.limits.max_vertices + 8 };
         let (bytes, parsed) = tokio::task::spawn_blocking(move || {
-            let r = geom::io::read(&bytes, &ReadOptions { limits, hint });
-            let summary = |r: &geom::io::ReadResult| geom::topology::Summary {
-                input_vertices: r.layout.as_ref().map(|l| l.n_vertices()),
-                ..geom::topology::summary(&r.mesh)
-            };
-            (bytes, r.map(|r| (r.format, summary(&r), r.warnings)))
+            // Parsed once, here: the reader, then the checks every job relies on (finite
+            // numbers, an extent, no zero-area face in a closed mesh).
+            let parsed = geom::io::read(&bytes, &ReadOptions { limits, hint }).and_then(|r| {
+                let s = geom::topology::checked_summary(&r.mesh, r.layout.as_ref().map(|l| l.n_vertices()))?;
+                // The attributes a job's `transfer` may name, checked at submission.
+                let names = geom::pipeline::attribute_names(&r.mesh, r.layout.as_ref());
+                Ok((r.format, geom::topology::Summary { attribute_names: Some(names), ..s }, r.warnings))
+            });
+            (bytes, parsed)
         })
         .await
         .map_err(ApiError::internal)?;
@@ -185,7 +210,18 @@ impl JobService {
                 format!("{role} mesh {id:?} is not known; upload it with POST /v1/meshes"),
             )
         })?;
-        serde_json::from_str(&m.summary).map_err(ApiError::internal)
+        // A summary stored before uploads were checked may hold nulls (overflowed numbers).
+        let unusable = |why: String| {
+            ApiError::new(
+                axum::http::StatusCode::UNPROCESSABLE_ENTITY,
+                "mesh_not_finite",
+                format!("{role} mesh {id:?} cannot be mapped: {why}; upload a scaled copy"),
+            )
+        };
+        let s: geom::topology::Summary =
+            serde_json::from_str(&m.summary).map_err(|e| unusable(format!("its summary does not read ({e})")))?;
+        s.check_finite().map_err(|e| unusable(e.to_string()))?;
+        Ok(s)
     }
 
     /// Validates a job against its meshes and queues it. Returns the job and whether it is new
@@ -317,7 +353,8 @@ impl JobService {
     }
 
     /// The job every time its state, stage, progress (to 0.1%) or attempts change, ending
-    /// after a terminal state. The first item is the job as it is now.
+    /// after a terminal state, or when the server stops (after the job as it is then). The
+    /// first item is the job as it is now.
     pub fn watch(&self, owner: String, first: JobRecord) -> impl Stream<Item = JobRecord> + Send + 'static + use<> {
         struct S {
             svc: JobService,
@@ -336,11 +373,19 @@ impl JobService {
                 let job = match s.first.take() {
                     Some(j) => j,
                     None => {
-                        tokio::time::sleep(s.svc.limits.watch_interval).await;
-                        match s.svc.store.get_job(&s.owner, &s.id).await {
+                        let stopping = tokio::select! {
+                            () = tokio::time::sleep(s.svc.limits.watch_interval) => false,
+                            () = s.svc.stopping.fired() => true,
+                        };
+                        let job = match s.svc.store.get_job(&s.owner, &s.id).await {
                             Ok(Some(j)) => j,
                             _ => return None,
+                        };
+                        if stopping {
+                            s.done = true;
+                            return Some((job, s));
                         }
+                        job
                     }
                 };
                 let key =

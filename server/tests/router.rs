@@ -24,8 +24,10 @@ async fn setup() -> T {
     let store = Store::connect(&format!("sqlite://{}", dir.path().join("t.db").display())).await.unwrap();
     let blobs = BlobStore::open(dir.path()).unwrap();
     let limits = Limits { max_body_bytes: 1 << 20, ..Limits::default() };
-    let state =
-        AppState { service: JobService { store: store.clone(), blobs: blobs.clone(), limits }, auth: Auth::new(&[]) };
+    let state = AppState {
+        service: JobService { store: store.clone(), blobs: blobs.clone(), limits, stopping: Default::default() },
+        auth: Auth::new(&[]),
+    };
     let worker = Worker { store, blobs, config: WorkerConfig::default() };
     T { _dir: dir, state, worker }
 }

@@ -26,20 +26,30 @@ impl JobSpec {
                 .into()),
             }
         };
-        match self {
+        let transfer = match self {
             JobSpec::Voronoi(s) | JobSpec::Greedy(s) => {
                 let (a, b) = pair(summaries.len())?;
-                s.check(self.method(), a, b).map(|_| ())
+                s.check(self.method(), a, b)?;
+                &s.options.transfer
             }
             JobSpec::Homology(s) => {
                 let (a, b) = pair(summaries.len())?;
-                s.check(a, b).map(|_| ())
+                s.check(a, b)?;
+                &s.options.transfer
             }
-            JobSpec::Quad(s) => s.check(summaries).map(|_| ()),
+            JobSpec::Quad(s) => return s.check(summaries).map(|_| ()),
             JobSpec::Spherical(s) => {
                 let (a, b) = pair(summaries.len())?;
-                s.check(a, b).map(|_| ())
+                s.check(a, b)?;
+                &s.options.transfer
             }
+        };
+        // The attributes `transfer` carries, when the source's summary records them.
+        match summaries.first().and_then(|s| s.attribute_names.as_deref()) {
+            Some(names) if !transfer.is_empty() => {
+                super::transfer_output::check_names(&super::transfer_output::parse(transfer)?, names)
+            }
+            _ => Ok(()),
         }
     }
 }
@@ -144,6 +154,10 @@ impl HomologySpec {
             ))
             .into());
         }
+        for (i, f) in self.features.iter().enumerate() {
+            feature_ids(&f.source, ss, &format!("feature {i} (source)"))?;
+            feature_ids(&f.target, ts, &format!("feature {i} (target)"))?;
+        }
         let curves = self.features.len() + ss.boundary_loops;
         let need = match ss.genus {
             0 if curves == 0 => {
@@ -184,6 +198,26 @@ impl HomologySpec {
         check_disjoint(&s, source.n_vertices(), "source")?;
         check_disjoint(&t, target.n_vertices(), "target")?;
         Ok((s, t))
+    }
+}
+
+/// What a feature curve's vertex list must satisfy on any mesh of this summary (the rest,
+/// edges between consecutive vertices and disjoint curves, is checked on the meshes): at least
+/// two vertices, each in range, none repeated but the first as the last of a closed curve.
+fn feature_ids(raw: &[u64], s: &Summary, what: &str) -> Result<()> {
+    let bad = |m: String| InputError::Features(format!("{what}: {m}")).into();
+    let n = s.id_count() as u64;
+    if raw.len() < 2 {
+        return Err(bad(format!("needs at least 2 vertices, has {}", raw.len())));
+    }
+    if let Some(r) = raw.iter().find(|&&r| r >= n) {
+        return Err(bad(format!("vertex {r} is out of range (the mesh has {n} vertices)")));
+    }
+    let open = if raw.len() > 2 && raw[0] == raw[raw.len() - 1] { &raw[..raw.len() - 1] } else { raw };
+    let mut seen = std::collections::HashSet::with_capacity(open.len());
+    match open.iter().find(|r| !seen.insert(**r)) {
+        Some(r) => Err(bad(format!("repeats vertex {r}"))),
+        None => Ok(()),
     }
 }
 

@@ -98,6 +98,7 @@ mod tests {
             bbox: [[0.0; 3], [1.0; 3]],
             bbox_diagonal: 3f64.sqrt(),
             area: 1.0,
+            attribute_names: None,
             input_vertices: None,
         }
     }

@@ -40,6 +40,7 @@ pub use spec::{
     FeatureSpec, GlobalOptions, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, METHODS, MapOptions, Method,
     RelaxOptions, SphericalOptions, SphericalSpec,
 };
+pub use transfer_output::attribute_names;
 
 use crate::error::{InputError, Result};
 use crate::mesh::{InputLayout, Mesh};

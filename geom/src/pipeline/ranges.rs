@@ -147,6 +147,14 @@ impl QuadOptions {
                 real(&format!("morph.weights[{k}][{i}]"), x, -1e3, 1e3, false)?;
             }
         }
+        // The wavelet morph analyses the uniform grid: an adaptive remesh has none (the run
+        // would fail after the whole parameterization).
+        if m.frames > 0 && m.domain == super::quad_spec::MorphDomain::Wavelet && self.adaptive_epsilon.is_some() {
+            return Err(InputError::OptionRange(
+                "options.morph.domain = \"wavelet\" needs uniform remeshing: drop options.adaptive_epsilon, or use the spatial morph".into(),
+            )
+            .into());
+        }
         Ok(())
     }
 }
@@ -180,6 +188,18 @@ mod tests {
         q.morph.frames = 10_000;
         let e = q.check_ranges(2).unwrap_err().to_string();
         assert!(e.contains("options.morph.frames") && e.contains("[0, 1000]"), "{e}");
+    }
+
+    #[test]
+    fn a_wavelet_morph_of_an_adaptive_remesh_is_refused_before_running() {
+        let mut q = QuadOptions { adaptive_epsilon: Some(0.01), ..Default::default() };
+        q.morph.frames = 3;
+        q.morph.domain = super::super::quad_spec::MorphDomain::Wavelet;
+        let e = q.check_ranges(2).unwrap_err();
+        assert_eq!(e.code(), "option_out_of_range");
+        assert!(e.to_string().contains("adaptive_epsilon"), "{e}");
+        q.morph.frames = 0;
+        assert!(q.check_ranges(2).is_ok(), "no morph, no wavelets");
     }
 
     #[test]

@@ -45,23 +45,37 @@ fn source_attributes(source: &Mesh, layout: Option<&InputLayout>) -> Attributes 
     layout.map_or_else(|| Attributes::from(source.attributes()), |l| l.attributes.clone())
 }
 
+/// The attribute names of a read mesh (its input layout's when it has one), as the server
+/// records them in the mesh's summary.
+pub fn attribute_names(mesh: &Mesh, layout: Option<&InputLayout>) -> Vec<String> {
+    source_attributes(mesh, layout).names()
+}
+
 /// Checks the source has every attribute asked for.
 ///
 /// # Errors
 /// `InputError::Invalid` naming the missing attribute and those the source has.
 pub fn check_source(o: &TransferOptions, source: &Mesh, layout: Option<&InputLayout>) -> Result<()> {
-    let a = source_attributes(source, layout);
+    check_names(o, &attribute_names(source, layout))
+}
+
+/// [`check_source`] on the source's attribute names (a summary's, before the job runs).
+///
+/// # Errors
+/// As [`check_source`].
+pub fn check_names(o: &TransferOptions, names: &[String]) -> Result<()> {
+    let has = |n: &str| names.iter().any(|x| x == n);
     let missing = o
         .texcoords
         .iter()
-        .find(|&&k| k >= a.texcoords.len())
+        .find(|&&k| !has(&format!("TEXCOORD_{k}")))
         .map(|k| format!("TEXCOORD_{k}"))
-        .or_else(|| (o.color && a.color.is_none()).then(|| "COLOR_0".to_string()))
-        .or_else(|| (o.skin && (a.joints.is_none() || a.weights.is_none())).then(|| "JOINTS_0/WEIGHTS_0".to_string()));
+        .or_else(|| (o.color && !has("COLOR_0")).then(|| "COLOR_0".to_string()))
+        .or_else(|| (o.skin && !(has("JOINTS_0") && has("WEIGHTS_0"))).then(|| "JOINTS_0/WEIGHTS_0".to_string()));
     match missing {
         Some(m) => Err(InputError::Invalid(format!(
             "transfer: the source has no {m} (it has: {})",
-            if a.names().is_empty() { "no attributes".to_string() } else { a.names().join(", ") }
+            if names.is_empty() { "no attributes".to_string() } else { names.join(", ") }
         ))
         .into()),
         None => Ok(()),

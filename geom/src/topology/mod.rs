@@ -1,11 +1,14 @@
 //! Topology queries: connected components, boundary loops, Euler characteristic and genus,
-//! the summary `surfmap inspect` prints, surface points and closest-point location (BVH).
+//! the summary `surfmap inspect` prints and the checks a mesh passes before any job (`admit`),
+//! surface points and closest-point location (BVH).
 
+mod admit;
 mod components;
 mod locate;
 mod loops;
 mod surface_point;
 
+pub use admit::checked_summary;
 pub use components::{Components, PartSummary, components, parts};
 pub(crate) use locate::plane_barycentric;
 pub use locate::{Locator, Projection};
@@ -39,6 +42,10 @@ pub struct Summary {
     /// vertex ids a job names on it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub input_vertices: Option<usize>,
+    /// The file's vertex attributes by glTF name (`TEXCOORD_0`, `COLOR_0`...), as a job's
+    /// `transfer` names them; absent when not recorded (checked at run time then).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub attribute_names: Option<Vec<String>>,
 }
 
 impl Summary {
@@ -80,6 +87,7 @@ pub fn summary(mesh: &Mesh) -> Summary {
         bbox_diagonal: (hi - lo).norm(),
         area: mesh.area(),
         input_vertices: None,
+        attribute_names: None,
     }
 }
 

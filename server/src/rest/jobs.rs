@@ -21,10 +21,11 @@ pub struct ListQuery {
     /// queued | running | succeeded | failed | cancelled
     #[param(pattern = "^(queued|running|succeeded|failed|cancelled)$")]
     pub state: Option<String>,
-    /// voronoi | greedy | homology | quad
-    #[param(pattern = "^(voronoi|greedy|homology|quad)$")]
+    /// voronoi | greedy | homology | quad | spherical
+    #[param(pattern = "^(voronoi|greedy|homology|quad|spherical)$")]
     pub method: Option<String>,
-    /// `next_cursor` of the previous page.
+    /// `next_cursor` of the previous page (a job id).
+    #[param(pattern = "^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$")]
     pub cursor: Option<String>,
     /// 1 to 500; 50 by default.
     #[param(minimum = 1, maximum = 500)]
@@ -128,7 +129,7 @@ pub async fn get_job(
 }
 
 /// Jobs, newest first, with filters and cursor paging.
-#[utoipa::path(get, path = "/v1/jobs", tag = "jobs", params(ListQuery), responses((status = 200, description = "a page of jobs, newest first", body = JobPage), (status = 400, description = "a bad filter or limit", body = ErrorBody)))]
+#[utoipa::path(get, path = "/v1/jobs", tag = "jobs", params(ListQuery), responses((status = 200, description = "a page of jobs, newest first", body = JobPage), (status = 400, description = "a bad filter, limit or cursor", body = ErrorBody)))]
 pub async fn list_jobs(
     State(st): State<AppState>,
     Owner(owner): Owner,
@@ -136,6 +137,9 @@ pub async fn list_jobs(
 ) -> Result<Json<JobPage>, ApiError> {
     if q.state.as_deref() == Some("") || q.method.as_deref() == Some("") {
         return Err(ApiError::bad_request("invalid_query", "state and method, when given, must not be empty"));
+    }
+    if q.cursor.as_deref() == Some("") {
+        return Err(ApiError::bad_request("invalid_cursor", "cursor, when given, is the next_cursor of a page"));
     }
     let filter = job_filter(
         q.state.as_deref().unwrap_or_default(),
@@ -163,9 +167,10 @@ pub async fn cancel_job(
 }
 
 /// Server-sent events: one `job` event (a JobView) per change of state, stage or progress;
-/// the stream ends after a terminal state.
+/// the stream ends after a terminal state. When the server shuts down it sends the job once
+/// more, then `event: shutdown` (`{code: "shutting_down", message}`), and ends: reconnect.
 #[utoipa::path(get, path = "/v1/jobs/{id}/events", tag = "jobs", params(("id" = String, Path)),
-    responses((status = 200, content_type = "text/event-stream", description = "`event: job` with a JobView as data"),
+    responses((status = 200, content_type = "text/event-stream", description = "`event: job` with a JobView as data; `event: shutdown` last when the server stops"),
         (status = 404, description = "unknown job", body = ErrorBody)))]
 pub async fn job_events(
     State(st): State<AppState>,
@@ -177,5 +182,10 @@ pub async fn job_events(
         let ev = Event::default().event("job");
         Ok(ev.json_data(job_view(&job)).unwrap_or_else(|_| Event::default().event("error")))
     });
-    Ok(Sse::new(stream).keep_alive(KeepAlive::default()))
+    let stopping = st.service.stopping.clone();
+    let last = futures::stream::once(async move { stopping.is_set() }).filter_map(|stopping| async move {
+        let body = ErrorBody { code: "shutting_down".into(), message: "the server is stopping; reconnect".into() };
+        stopping.then(|| Ok(Event::default().event("shutdown").json_data(body).unwrap_or_default()))
+    });
+    Ok(Sse::new(stream.chain(last)).keep_alive(KeepAlive::default()))
 }

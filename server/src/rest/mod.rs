@@ -110,6 +110,16 @@ pub async fn not_found() -> ApiError {
     ApiError::not_found("route_not_found", "no such route")
 }
 
+/// The JSON 405 of a known route called with a method it does not take (axum keeps the
+/// `Allow` header).
+pub async fn method_not_allowed() -> ApiError {
+    ApiError::new(
+        axum::http::StatusCode::METHOD_NOT_ALLOWED,
+        "method_not_allowed",
+        "this route does not take that method (see the Allow header)",
+    )
+}
+
 /// The REST routes.
 pub fn router(state: AppState) -> Router {
     let limit = state.service.limits.max_body_bytes;
@@ -125,6 +135,7 @@ pub fn router(state: AppState) -> Router {
         .route("/healthz", get(ops::healthz))
         .route("/readyz", get(ops::readyz))
         .route("/metrics", get(ops::metrics))
+        .method_not_allowed_fallback(method_not_allowed)
         .layer(DefaultBodyLimit::max(limit))
         .with_state(state)
 }

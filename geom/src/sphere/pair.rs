@@ -53,7 +53,7 @@ impl Default for SpherePairOptions {
         Self {
             newton: SphereNewtonOptions { max_iterations: 100, ..SphereNewtonOptions::default() },
             untangle_iterations: 100,
-            global_iterations: 100,
+            global_iterations: 250,
         }
     }
 }

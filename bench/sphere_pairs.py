@@ -20,18 +20,12 @@ SHARED = os.path.join(HERE, "..", "..", "shared")
 sys.path.insert(0, os.path.join(SHARED, "eval"))
 import meshmetrics as mm  # noqa: E402
 
+sys.path.insert(0, HERE)
+from different import fps_from as fps  # noqa: E402
+
 M = os.path.join(SHARED, "meshes")
 L = os.path.join(M, "landmarks")
 R = os.path.join(M, "registered")
-
-
-def fps(V, k, start=0):
-    chosen = [start]
-    d = np.linalg.norm(V - V[start], axis=1)
-    for _ in range(k - 1):
-        chosen.append(int(d.argmax()))
-        d = np.minimum(d, np.linalg.norm(V - V[chosen[-1]], axis=1))
-    return chosen
 
 
 def cases(tmp):
@@ -51,7 +45,7 @@ def cases(tmp):
     man, woman = os.path.join(R, "smpl_human/human_man.obj"), os.path.join(R, "smpl_human/human_woman.obj")
     V, _ = mm.load_mesh(man)
     for k in (6, 12):
-        yield f"SMPL {k}", man, woman, [[i, i] for i in fps(V, k)], np.arange(len(V)), None
+        yield f"SMPL {k}", man, woman, [[i, i] for i in fps(V, k, 0)], np.arange(len(V)), None
     cat, lion = os.path.join(R, "sumner_cat_lion/cat-reference.obj"), os.path.join(R, "sumner_cat_lion/lion-reference.obj")
     mk = np.loadtxt(os.path.join(R, "sumner_cat_lion/cat_lion_markers.txt"), dtype=int, usecols=(0, 1))
     C, _ = mm.load_mesh(cat)

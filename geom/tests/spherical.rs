@@ -1,28 +1,13 @@
 //! The `spherical` method end to end through `run_job`: both directions fold-free with anchors
 //! exact on a twisted copy, equal connectivity of the outputs, and the spec's edges.
 
-use geom::mesh::{Mesh, P3, shapes};
+use geom::mesh::shapes;
 use geom::pipeline::{JobReport, JobSpec, run_job};
 use geom::progress::NoProgress;
 
-/// An icosphere stretched, squashed and twisted about its axis.
-fn deformed(level: usize) -> Mesh {
-    let m = shapes::icosphere(level);
-    let pos: Vec<P3> = m
-        .positions()
-        .iter()
-        .map(|p| {
-            let a = 0.8 * p.z;
-            let (x, y) = (p.x * a.cos() - p.y * a.sin(), p.x * a.sin() + p.y * a.cos());
-            P3::new(1.6 * x, 0.9 * y, 0.7 * p.z)
-        })
-        .collect();
-    Mesh::from_triangles(pos, &m.face_indices()).unwrap()
-}
-
 #[test]
 fn a_twisted_copy_maps_both_ways_without_folds_and_with_anchors_exact() {
-    let (a, b) = (shapes::icosphere(3), deformed(3));
+    let (a, b) = (shapes::icosphere(3), shapes::twisted_icosphere(3));
     let spec =
         JobSpec::from_json(br#"{"method": "spherical", "anchors": [[0, 0], [7, 7], [40, 40], [300, 300]]}"#).unwrap();
     let (report, arts) = run_job(&spec, &[a.clone(), b.clone()], &mut NoProgress).unwrap();

@@ -2,46 +2,15 @@
 //! paging, SSE, artifacts, metrics and the OpenAPI document, with jobs drained step by step by a
 //! worker in the test.
 
+mod common;
+
 use axum::body::Body;
 use axum::http::{Request, StatusCode};
+use common::{call, json_call, setup};
 use geom::io::Format;
-use http_body_util::BodyExt;
 use serde_json::{Value, json};
-use surfmap_server::service::{JobService, Limits};
-use surfmap_server::{AppState, app, auth::Auth};
-use surfmap_store::{BlobStore, Store};
-use surfmap_worker::{Ran, Worker, WorkerConfig};
-use tower::ServiceExt;
-
-struct T {
-    _dir: tempfile::TempDir,
-    state: AppState,
-    worker: Worker,
-}
-
-async fn setup() -> T {
-    let dir = tempfile::tempdir().unwrap();
-    let store = Store::connect(&format!("sqlite://{}", dir.path().join("t.db").display())).await.unwrap();
-    let blobs = BlobStore::open(dir.path()).unwrap();
-    let limits = Limits { max_body_bytes: 1 << 20, ..Limits::default() };
-    let state = AppState {
-        service: JobService { store: store.clone(), blobs: blobs.clone(), limits, stopping: Default::default() },
-        auth: Auth::new(&[]),
-    };
-    let worker = Worker { store, blobs, config: WorkerConfig::default() };
-    T { _dir: dir, state, worker }
-}
-
-async fn call(t: &T, req: Request<Body>) -> (StatusCode, axum::http::HeaderMap, Vec<u8>) {
-    let r = app(t.state.clone()).oneshot(req).await.unwrap();
-    let (parts, body) = r.into_parts();
-    (parts.status, parts.headers, body.collect().await.unwrap().to_bytes().to_vec())
-}
-
-async fn json_call(t: &T, method: &str, uri: &str, body: Body) -> (StatusCode, Value) {
-    let (s, _, b) = call(t, Request::builder().method(method).uri(uri).body(body).unwrap()).await;
-    (s, serde_json::from_slice(&b).unwrap_or(Value::Null))
-}
+use surfmap_store::BlobStore;
+use surfmap_worker::Ran;
 
 fn sphere_pair() -> (Vec<u8>, Vec<u8>) {
     let s = geom::mesh::shapes::icosphere(3);

@@ -79,6 +79,22 @@ pub fn icosphere(k: usize) -> Mesh {
     build(pos, &tris)
 }
 
+/// An icosphere stretched, squashed and twisted about its axis (the same connectivity as
+/// [`icosphere`]`(k)`): a smooth genus-0 deformation to map a sphere onto.
+pub fn twisted_icosphere(k: usize) -> Mesh {
+    let m = icosphere(k);
+    let pos: Vec<P3> = m
+        .positions()
+        .iter()
+        .map(|p| {
+            let a = 0.8 * p.z;
+            let (x, y) = (p.x * a.cos() - p.y * a.sin(), p.x * a.sin() + p.y * a.cos());
+            P3::new(1.6 * x, 0.9 * y, 0.7 * p.z)
+        })
+        .collect();
+    build(pos, &m.face_indices())
+}
+
 /// A torus with `n` segments around the big circle and `m` around the tube.
 pub fn torus(n: usize, m: usize, big_r: f64, small_r: f64) -> Mesh {
     let mut pos = Vec::with_capacity(n * m);

@@ -303,24 +303,9 @@ mod tests {
     use crate::progress::NoProgress;
     use crate::sphere::{SphereEmbedOptions, embed_sphere};
 
-    /// An icosphere stretched, squashed and twisted about its axis.
-    fn deformed(level: usize) -> Mesh {
-        let m = shapes::icosphere(level);
-        let pos: Vec<P3> = m
-            .positions()
-            .iter()
-            .map(|p| {
-                let a = 0.8 * p.z;
-                let (x, y) = (p.x * a.cos() - p.y * a.sin(), p.x * a.sin() + p.y * a.cos());
-                P3::new(1.6 * x, 0.9 * y, 0.7 * p.z)
-            })
-            .collect();
-        Mesh::from_triangles(pos, &m.face_indices()).unwrap()
-    }
-
     #[test]
     fn a_twisted_copy_maps_bijectively_with_anchors_exact_and_every_image_upright() {
-        let (a, b) = (shapes::icosphere(3), deformed(3));
+        let (a, b) = (shapes::icosphere(3), shapes::twisted_icosphere(3));
         let ea = embed_sphere(&a, &SphereEmbedOptions::default(), &NoProgress).unwrap();
         let eb = embed_sphere(&b, &SphereEmbedOptions::default(), &NoProgress).unwrap();
         let anchors = [(0, 0), (7, 7), (40, 40), (300, 300)];

@@ -18,10 +18,8 @@ pub struct SphereLocator<'m> {
     mesh: &'m Mesh,
     points: &'m [P3],
     tris: Vec<[u32; 3]>,
-    /// Unit face normals, and per vertex the normal at a point that sits on it (as an anchor
-    /// does).
+    /// Unit face normals.
     face_normals: Vec<V3>,
-    vertex_normals: Vec<V3>,
     /// Per vertex, the area-weighted mean of its faces' normals (interpolated across a face, a
     /// normal field without jumps at edges).
     smooth_normals: Vec<V3>,
@@ -41,19 +39,6 @@ impl<'m> SphereLocator<'m> {
         let tris = mesh.face_indices();
         let unit = |n: &V3| n.try_normalize(0.0).unwrap_or_else(V3::zeros);
         let face_normals: Vec<V3> = face_raw.iter().map(unit).collect();
-        // At a vertex, the normal of the adjacent face whose centroid is nearest: the face the
-        // evaluator's closest-point search settles on for a point that sits on the vertex.
-        let pos = mesh.positions();
-        let mut best = vec![(f64::INFINITY, V3::zeros()); mesh.n_vertices()];
-        for (f, t) in tris.iter().enumerate() {
-            let c = (pos[t[0] as usize].coords + pos[t[1] as usize].coords + pos[t[2] as usize].coords) / 3.0;
-            for &v in t {
-                let d = (c - pos[v as usize].coords).norm_squared();
-                if d < best[v as usize].0 {
-                    best[v as usize] = (d, face_normals[f]);
-                }
-            }
-        }
         let mut smooth = vec![V3::zeros(); mesh.n_vertices()];
         for (t, n) in tris.iter().zip(&face_raw) {
             for &v in t {
@@ -61,14 +46,7 @@ impl<'m> SphereLocator<'m> {
             }
         }
         let smooth_normals = smooth.iter().map(unit).collect();
-        Self {
-            mesh,
-            points,
-            face_normals,
-            vertex_normals: best.into_iter().map(|b| b.1).collect(),
-            smooth_normals,
-            tris,
-        }
+        Self { mesh, points, face_normals, smooth_normals, tris }
     }
 
     pub fn mesh(&self) -> &Mesh {
@@ -127,10 +105,14 @@ impl<'m> SphereLocator<'m> {
         P3::from(p(0) * l.bary[0] + p(1) * l.bary[1] + p(2) * l.bary[2])
     }
 
-    /// The surface normal at a location: the face's, or the vertex's when it sits on one.
+    /// The surface normal at a location: the face's, or the vertex's smooth normal when it
+    /// sits on one (as an anchor does), since which of its faces a triangle leaves it through
+    /// is not known from the point alone. (The face nearest by centroid, where the
+    /// evaluator's closest-point search may settle, called 26 faces of the cow's identity map
+    /// turned over at its sharp vertices.)
     pub fn normal(&self, l: &Located) -> V3 {
         match l.bary.iter().position(|&b| b >= 1.0 - 1e-9) {
-            Some(k) => self.vertex_normals[self.tris[l.face as usize][k] as usize],
+            Some(k) => self.smooth_normals[self.tris[l.face as usize][k] as usize],
             None => self.face_normals[l.face as usize],
         }
     }
@@ -197,15 +179,12 @@ impl SphereImage for OnTarget<'_> {
     fn image(&self, v: u32, p: &P3, frame: &[V3; 2]) -> Option<Image> {
         let l = self.locate(v, p);
         let (x, d) = self.locator.image_in(l.face, p, frame);
-        Some(Image { x, d })
+        let at_vertex = l.bary.iter().any(|&b| b >= 1.0 - 1e-9);
+        Some(Image { x, d, up: self.locator.normal(&l), at_vertex, smooth: self.locator.smooth_normal(&l) })
     }
     fn up_at(&self, near: u32, p: &P3) -> V3 {
         let hint = self.hints.get(near as usize).map_or(0, |h| h.load(Ordering::Relaxed));
         self.locator.normal(&self.locator.locate(p, hint))
-    }
-    fn smooth_up_at(&self, near: u32, p: &P3) -> V3 {
-        let hint = self.hints.get(near as usize).map_or(0, |h| h.load(Ordering::Relaxed));
-        self.locator.smooth_normal(&self.locator.locate(p, hint))
     }
 }
 

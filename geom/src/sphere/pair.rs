@@ -16,7 +16,7 @@
 //!    energy alone here left strips of mirrored images that cost it nothing (cow: 15 and 41
 //!    evaluator flips against 1 and 4, cat -> horse 61 and 62 against 3 and 0).
 //! 4. **Untangle** ([`SphereNewton::untangle`]): the images still turned over, turned back with
-//!    `ε` on Garanzha's schedule while the others stay upright.
+//!    `ε` on Garanzha's schedule, every image measured by it.
 //! 5. **Distortion** ([`SphereNewton::minimize`]): projected Newton on the symmetric Dirichlet
 //!    energy of each source triangle against its chord on the target (the evaluator's measure),
 //!    anchors held, every accepted step bijective on the sphere and every image upright.

@@ -239,3 +239,40 @@ def test_async_client(server, auth_server, pair, spec, tmp_path):
                 await anon.list_jobs()
 
     asyncio.run(run())
+
+
+def test_wait_drives_a_tqdm_bar(server, done, monkeypatch):
+    import sys
+    import types
+
+    bars = []
+
+    class FakeBar:
+        def __init__(self, total, **kw):
+            self.total, self.n, self.desc, self.closed = total, 0, "", False
+            bars.append(self)
+
+        def set_description_str(self, d):
+            self.desc = d
+
+        def refresh(self):
+            pass
+
+        def close(self):
+            self.closed = True
+
+    mod = types.ModuleType("tqdm.auto")
+    mod.tqdm = FakeBar
+    monkeypatch.setitem(sys.modules, "tqdm", types.ModuleType("tqdm"))
+    monkeypatch.setitem(sys.modules, "tqdm.auto", mod)
+    with Client(server.url) as c:
+        job = c.wait(done[0].id, progress=True)
+    assert job.state == "succeeded"
+    assert len(bars) == 1 and (bars[0].n, bars[0].total, bars[0].closed) == (100, 100, True)
+    assert bars[0].desc.startswith("succeeded")
+    # Without tqdm, progress=True draws nothing; progress="tqdm" asks for it.
+    monkeypatch.setitem(sys.modules, "tqdm.auto", None)
+    with Client(server.url) as c:
+        assert c.wait(done[0].id, progress=True).state == "succeeded"
+        with pytest.raises(ImportError):
+            c.wait(done[0].id, progress="tqdm")

@@ -45,7 +45,7 @@ function actions(j) {
       b.disabled = true;
       try {
         const n = await api('/v1/jobs', { method: 'POST', body: { meshes: j.meshes, spec: j.spec } });
-        say(`retried as ${n.id.slice(0, 8)}`);
+        say(`retried as …${n.id.slice(-12)}`);
         await refresh();
       } catch (e) { say(e.message, true); b.disabled = false; }
     };
@@ -59,7 +59,7 @@ function render(j) {
   tr.dataset.id = j.id;
   tr.dataset.state = j.state;
   tr.append(
-    el('td', {}, el('a', { href: `/ui/jobs/${j.id}`, title: j.id }, el('code', {}, j.id.slice(0, 8)))),
+    el('td', {}, el('a', { href: `/ui/jobs/${j.id}`, title: j.id }, el('code', {}, `…${j.id.slice(-12)}`))),
     el('td', { className: 'method' }, j.method),
     el('td', { className: 'state' }, el('span', { className: `pill ${j.state}` }, j.state),
       j.error ? el('small', { className: 'code', title: j.error.message }, ` ${j.error.code}`) : null),
@@ -149,7 +149,7 @@ async function main() {
   document.getElementById('more').onclick = () => older().catch((e) => say(e.message, true));
   await refresh();
   // New jobs, and unfinished jobs beyond the streams followed, every few seconds.
-  setInterval(() => refresh().catch((e) => say(e.message, true)), 4000);
+  setInterval(() => refresh().catch((e) => say(e.message, true)), 3000);
 }
 
 main().catch((e) => say(e.message, true));

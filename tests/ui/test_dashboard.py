@@ -1,7 +1,8 @@
 """The dashboard in headless Chromium against the real server (two tokens): the jobs page signs
 in with a token, shows a job submitted after it opened reach `succeeded` without a reload,
 filters, cancels and retries; the job page's viewer draws both meshes; the other token's pages
-show neither the job nor its viewer. Screenshots are written to target/ui-screenshots/."""
+show neither the job nor its viewer. Screenshots are written to ui-screenshots/ in the
+cargo target directory ($CARGO_TARGET_DIR, else target/) or $SURFMAP_UI_SCREENSHOTS."""
 
 from __future__ import annotations
 
@@ -15,7 +16,8 @@ from harness import ANCHORS, deformed, icosphere
 from surfmap import Client
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-SHOTS = pathlib.Path(os.environ.get("SURFMAP_UI_SCREENSHOTS", ROOT / "target" / "ui-screenshots"))
+TARGET = pathlib.Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+SHOTS = pathlib.Path(os.environ.get("SURFMAP_UI_SCREENSHOTS", TARGET / "ui-screenshots"))
 TIMEOUT_MS = 180_000
 
 
@@ -51,14 +53,28 @@ def test_dashboard(server, browser, meshes):
     page.evaluate("window.__loaded_once = true")
     assert page.evaluate("sessionStorage.getItem('surfmap-token')") == "alpha-token"
 
-    # A job submitted now appears and reaches `succeeded` on the open page.
+    # Jobs submitted now appear and change on the open page: a long job holds the only worker,
+    # a small one waits behind it (queued); the long one is cancelled from its row, then the
+    # small one runs and succeeds, all followed over the events stream.
     page.evaluate("""() => { window.__states = []; new MutationObserver(() => {
-        for (const r of document.querySelectorAll('tr.job')) window.__states.push(r.dataset.state); })
+        for (const r of document.querySelectorAll('tr.job')) window.__states.push(r.dataset.id + ':' + r.dataset.state); })
         .observe(document.querySelector('#jobs tbody'), {childList: true, subtree: true}); }""")
+    lv, lf = icosphere(5)
+    long = alpha.submit((lv, lf), (deformed(lv), lf), {"method": "voronoi", "anchors": ANCHORS,
+                                                         "options": {"smoothing": {"iterations": 10000, "tolerance": 0.0}}})
+    for j in alpha.events(long.id):
+        if j.state == "running":
+            break
     job = alpha.map(meshes[0], meshes[1], {"method": "voronoi", "anchors": ANCHORS})
-    row(page, job.id).wait_for(timeout=30_000)
+    page.wait_for_selector(f'tr.job[data-id="{job.id}"][data-state="queued"]', timeout=30_000)
+    page.wait_for_selector(f'tr.job[data-id="{long.id}"][data-state="running"]', timeout=30_000)
+    page.screenshot(path=str(SHOTS / "jobs-running.png"), full_page=True)
+    row(page, long.id).locator("button.cancel").click()
+    page.wait_for_selector(f'tr.job[data-id="{long.id}"][data-state="cancelled"]', timeout=60_000)
     page.wait_for_selector(f'tr.job[data-id="{job.id}"][data-state="succeeded"]', timeout=TIMEOUT_MS)
     assert page.evaluate("window.__loaded_once") is True, "the page was reloaded"
+    states = [s.split(":", 1)[1] for s in page.evaluate("window.__states") if s.startswith(job.id)]
+    assert states[0] == "queued" and states[-1] == "succeeded", states
     assert row(page, job.id).locator(".stage").inner_text() != ""
     assert "100%" in row(page, job.id).locator(".progress").inner_text()
     page.screenshot(path=str(SHOTS / "jobs.png"), full_page=True)
@@ -70,23 +86,20 @@ def test_dashboard(server, browser, meshes):
     page.select_option("#filters select[name=state]", "succeeded")
     page.select_option("#filters select[name=method]", "voronoi")
     row(page, job.id).wait_for()
+    assert row(page, long.id).count() == 0
     assert "state=succeeded" in page.url and "method=voronoi" in page.url
     page.select_option("#filters select[name=method]", "greedy")
     page.wait_for_selector("#empty:not([hidden])")
     page.select_option("#filters select[name=state]", "")
     page.select_option("#filters select[name=method]", "")
 
-    # Cancel a long job from its row, then retry it (a new job with the same spec).
-    lv, lf = icosphere(5)
-    long = alpha.submit((lv, lf), (deformed(lv), lf), {"method": "voronoi", "anchors": ANCHORS,
-                                                         "options": {"smoothing": {"iterations": 10000, "tolerance": 0.0}}})
-    row(page, long.id).locator("button.cancel").click(timeout=30_000)
-    page.wait_for_selector(f'tr.job[data-id="{long.id}"][data-state="cancelled"]', timeout=60_000)
-    row(page, long.id).locator("button.retry").click()
+    # Retry the cancelled job from its row: a new job with the same meshes and spec.
+    row(page, long.id).locator("button.retry").click(timeout=30_000)
     page.wait_for_function(f"""() => [...document.querySelectorAll('tr.job')].some(
         r => r.dataset.id !== '{long.id}' && r.dataset.id !== '{job.id}')""", timeout=30_000)
     retried = [j for j in alpha.jobs() if j.id not in (job.id, long.id)]
     assert len(retried) == 1 and retried[0].spec == alpha.job(long.id).spec
+    assert retried[0].meshes == long.meshes
     alpha.cancel(retried[0].id)
 
     # The job page: spec, timings, metrics, artifacts, and the viewer drawing both meshes.
@@ -111,6 +124,16 @@ def test_dashboard(server, browser, meshes):
     page.locator("#viewer canvas").screenshot(path=str(SHOTS / "viewer-distortion.png"))
     assert errors == [], errors
 
+    # The cancelled job's page: its state, its error code if it has one, a retry button, no viewer.
+    page.goto(f"{server.url}/ui/jobs/{long.id}")
+    page.wait_for_selector("#state")
+    assert page.locator("#state").inner_text() == "cancelled"
+    code = alpha.job(long.id).error
+    if code:
+        assert page.locator("#error-code").inner_text() == code.code
+    assert page.locator("button.retry").count() == 1 and page.locator("#viewer-section").is_hidden()
+    assert errors == [], errors
+
     # Another token (sent by a front proxy on every request: honoured, no prompt) sees no job.
     other = browser.new_context(viewport={"width": 1280, "height": 700},
                                 extra_http_headers={"Authorization": "Bearer beta-token"})
@@ -119,7 +142,7 @@ def test_dashboard(server, browser, meshes):
     page2.goto(f"{server.url}/ui/")
     page2.wait_for_selector("#empty:not([hidden])")
     assert page2.locator("#login").count() == 0
-    assert page2.locator("tr.job").count() == 0 and job.id[:8] not in page2.content()
+    assert page2.locator("tr.job").count() == 0 and job.id[-12:] not in page2.content()
     page2.screenshot(path=str(SHOTS / "jobs-other-token.png"), full_page=True)
     page2.goto(f"{server.url}/ui/jobs/{job.id}")
     page2.wait_for_selector("#status.error")

@@ -24,8 +24,9 @@ def auth_server(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def limited_server(tmp_path_factory):
-    """Jobs that run over 2 s fail with `time_limit`."""
-    s = Server(tmp_path_factory.mktemp("limited"), "--workers", "1", "--time-limit-secs", "2", "--max-attempts", "1")
+    """Jobs that run over 2 s fail with `time_limit`; bodies over 1 MiB are refused."""
+    s = Server(tmp_path_factory.mktemp("limited"), "--workers", "1", "--time-limit-secs", "2", "--max-attempts", "1",
+               "--max-body-mb", "1")
     yield s
     s.stop()
 

@@ -173,6 +173,14 @@ def test_tokens_and_tenants(auth_server, pair, spec):
                 call()
 
 
+def test_a_body_over_the_limit_is_413(limited_server):
+    v, f = icosphere(6)  # about 4 MB of OBJ
+    with Client(limited_server.url) as c:
+        with pytest.raises(surfmap.PayloadTooLarge) as e:
+            c.upload((v, f))
+    assert (e.value.status, e.value.code) == (413, "payload_too_large")
+
+
 def test_a_job_that_fails_raises_its_code(limited_server, long_pair, long_spec):
     with Client(limited_server.url) as c:
         with pytest.raises(surfmap.JobFailed) as e:

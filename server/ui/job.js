@@ -143,16 +143,23 @@ async function main() {
     throw e;
   }
   show(j);
-  if (!TERMINAL.has(j.state)) {
-    let last = j;
-    await events(j.links.events, (name, data) => {
-      if (name !== 'job') return;
-      // Progress alone redraws the summary; the details once the state changes.
-      if (data.state !== last.state) show(data); else renderSummary(data);
-      last = data;
-    });
+  let last = j;
+  while (!TERMINAL.has(last.state)) {
+    try {
+      await events(j.links.events, (name, data) => {
+        if (name !== 'job') return;
+        // Progress alone redraws the summary; the details once the state changes.
+        if (data.state !== last.state) show(data); else renderSummary(data);
+        last = data;
+      });
+    } catch (e) {
+      if (e instanceof ApiError) throw e;
+      await new Promise((r) => setTimeout(r, 1000)); // a dropped stream: follow it again
+    }
     // The stream ends after a terminal state (or on a shutdown): read the job as it stands.
-    show(await api(`/v1/jobs/${encodeURIComponent(id)}`));
+    const now = await api(`/v1/jobs/${encodeURIComponent(id)}`);
+    if (now.state !== last.state || TERMINAL.has(now.state)) show(now);
+    last = now;
   }
 }
 

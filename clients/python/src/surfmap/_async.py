@@ -181,8 +181,8 @@ class AsyncClient:
                         if job.done or (deadline is not None and time.monotonic() > deadline):
                             break
                     await stream.aclose()
-                except httpx.ReadTimeout:
-                    pass
+                except (httpx.ReadTimeout, httpx.RemoteProtocolError, httpx.ReadError):
+                    pass  # a quiet or dropped stream: read the job and follow it again
                 if not job.done:
                     job = await self.job(job_id)
             report(job)

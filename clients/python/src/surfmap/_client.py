@@ -265,8 +265,8 @@ class Client:
                             break
                         if deadline is not None and time.monotonic() > deadline:
                             break
-                except httpx.ReadTimeout:
-                    pass
+                except (httpx.ReadTimeout, httpx.RemoteProtocolError, httpx.ReadError):
+                    pass  # a quiet or dropped stream: read the job and follow it again
                 if not job.done:
                     job = self.job(job_id)
             report(job)

@@ -197,7 +197,7 @@ export class Viewer {
     const logs = ratio.map((r) => Math.log2(Math.max(r * norm, 1e-6)));
     const sorted = Float32Array.from(logs, Math.abs).sort();
     this.distortionScale = Math.max(0.1, sorted[Math.floor(0.95 * (sorted.length - 1))] || 0);
-    if (!this.flat) this.flat = this.src.toNonIndexed(); // keeps the morph target
+    if (!this.flat) this.flat = this.flatten(idx, p);
     const col = new Float32Array(nf * 9);
     for (let f = 0; f < nf; f++) {
       const c = heat(logs[f] / this.distortionScale);
@@ -207,10 +207,41 @@ export class Viewer {
     this.srcMesh.geometry = this.flat;
   }
 
+  /**
+   * The source with one vertex per face corner (for per-face colours), without a morph target:
+   * the morph is baked into its positions (a morph texture of that size is slow to build).
+   */
+  flatten(idx, p) {
+    const n = idx ? idx.length : p.length / 3;
+    const base = new Float32Array(3 * n), image = new Float32Array(3 * n);
+    for (let c = 0; c < n; c++) {
+      const v = idx ? idx[c] : c;
+      for (let k = 0; k < 3; k++) {
+        base[3 * c + k] = p[3 * v + k];
+        image[3 * c + k] = this.image[3 * v + k];
+      }
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(base.slice(), 3));
+    g.computeVertexNormals();
+    this.flatBase = base;
+    this.flatImage = image;
+    this.bake(g, this.weight || 0);
+    return g;
+  }
+
+  bake(g, w) {
+    const pos = g.attributes.position;
+    const a = pos.array, b = this.flatBase, im = this.flatImage;
+    for (let i = 0; i < a.length; i++) a[i] = b[i] + w * (im[i] - b[i]);
+    pos.needsUpdate = true;
+  }
+
   /** Morph weight 0 (the source) to 1 (the source placed on the target). */
   morph(w) {
     this.weight = w;
     if (this.srcMesh.morphTargetInfluences) this.srcMesh.morphTargetInfluences[0] = w;
+    if (this.flat) this.bake(this.flat, w);
     this.markAnchors(this.anchorGroups[0].visible);
     this.draw();
   }

@@ -95,7 +95,22 @@ function renderDetails(j) {
     el('h2', {}, 'Spec'), el('pre', { id: 'spec' }, compactJson(j.spec)),
     el('h2', {}, 'Timings per stage'), timings(j.result) || el('p', {}, j.state === 'succeeded' ? 'Not reported.' : 'When the job has succeeded.'),
     el('h2', {}, 'Metrics'), metrics(j.result) || el('p', {}, 'When the job has succeeded.'),
-    el('h2', {}, 'Artifacts'), artifacts(j));
+    el('h2', {}, 'Artifacts'), artifacts(j),
+    geometryImages(j));
+}
+
+/** A quad job's geometry and normal images (16-bit PNG), one row per mesh. */
+function geometryImages(j) {
+  const pngs = j.artifacts.filter((a) => /^(geometry|normal)_\d+_patch\d+\.png$/.test(a.name));
+  if (!pngs.length) return null;
+  const box = el('div', { id: 'geometry-images' });
+  for (const a of pngs) {
+    const img = el('img', { alt: a.name, title: a.name, className: 'gimg' });
+    bytes(a.url).then((b) => { img.src = URL.createObjectURL(new Blob([b], { type: 'image/png' })); })
+      .catch((e) => say(e.message, true));
+    box.append(el('figure', {}, img, el('figcaption', {}, a.name.replace('.png', ''))));
+  }
+  return el('div', {}, el('h2', {}, 'Geometry images'), box);
 }
 
 async function showViewer(j) {
@@ -109,8 +124,15 @@ async function showViewer(j) {
   vs.textContent = 'loading…';
   const { Viewer } = await import('/ui/assets/viewer.js');
   const viewer = new Viewer(document.getElementById('viewer'));
-  const [src, tgt] = await Promise.all([bytes(morph.url), bytes(`/v1/meshes/${j.target}/glb`)]);
-  const info = await viewer.load(src, tgt, j.spec);
+  // A quad job's morph.glb holds mesh 0's remesh with the others' as morph targets: shown
+  // side by side (its anchors count the input meshes' vertices, not the remeshes': not drawn).
+  const quad = j.method === 'quad';
+  const [src, tgt] = await Promise.all([bytes(morph.url), quad ? null : bytes(`/v1/meshes/${j.target}/glb`)]);
+  const info = await viewer.load(src, tgt, quad ? {} : j.spec);
+  if (quad) {
+    document.querySelector('#viewer .tag.left').textContent = 'remesh of mesh 0';
+    document.querySelector('#viewer .tag.right').textContent = `remesh of mesh ${j.meshes.length - 1}`;
+  }
   vs.textContent = `${info.sourceVertices} source, ${info.targetVertices} target vertices`;
   document.getElementById('colouring').onchange = (e) => {
     viewer.colour(e.target.value);

@@ -131,8 +131,15 @@ export class Viewer {
    */
   async load(sourceGlb, targetGlb, spec) {
     this.src = await parse(sourceGlb);
-    this.tgt = await parse(targetGlb);
     this.image = morphPositions(this.src);
+    if (targetGlb) {
+      this.tgt = await parse(targetGlb);
+    } else {
+      // The right side is the morph target itself (a quad job's last remesh: same faces).
+      this.tgt = new THREE.BufferGeometry();
+      this.tgt.setIndex(this.src.index);
+      this.tgt.setAttribute('position', new THREE.BufferAttribute(this.image.slice(), 3));
+    }
     if (!this.src.attributes.normal) this.src.computeVertexNormals();
     if (!this.tgt.attributes.normal) this.tgt.computeVertexNormals();
     this.targetBox = box(this.tgt.attributes.position.array);
@@ -240,7 +247,9 @@ export class Viewer {
   /** Morph weight 0 (the source) to 1 (the source placed on the target). */
   morph(w) {
     this.weight = w;
-    if (this.srcMesh.morphTargetInfluences) this.srcMesh.morphTargetInfluences[0] = w;
+    // The last morph target: the one the colours follow (a quad job's last remesh).
+    const inf = this.srcMesh.morphTargetInfluences;
+    if (inf && inf.length) inf[inf.length - 1] = w;
     if (this.flat) this.bake(this.flat, w);
     this.markAnchors(this.anchorGroups[0].visible);
     this.draw();

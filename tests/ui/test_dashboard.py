@@ -124,6 +124,21 @@ def test_dashboard(server, browser, meshes):
     page.locator("#viewer canvas").screenshot(path=str(SHOTS / "viewer-distortion.png"))
     assert errors == [], errors
 
+    # A quad job's page: the two remeshes side by side, and the geometry images.
+    quad = alpha.map(meshes[0], meshes[1], {"method": "quad", "anchors": [[0, 0], [3, 3], [4, 4], [7, 7]],
+                                             "options": {"level": 3}}, wait=True, timeout=300)
+    page.goto(f"{server.url}/ui/jobs/{quad.id}")
+    page.wait_for_function("!!window.surfmapViewer", timeout=60_000)
+    cov = page.evaluate("window.surfmapViewer.coverage()")
+    assert cov["left"] > 0.02 * area and cov["right"] > 0.02 * area, cov
+    assert page.locator("#viewer .tag.right").inner_text() == "remesh of mesh 1"
+    n_png = sum(a.name.endswith(".png") for a in quad.artifacts)
+    assert n_png >= 4
+    page.wait_for_function(f"""() => [...document.querySelectorAll('#geometry-images img')]
+        .filter(i => i.complete && i.naturalWidth > 0).length === {n_png}""", timeout=30_000)
+    page.screenshot(path=str(SHOTS / "job-quad.png"), full_page=True)
+    assert errors == [], errors
+
     # The cancelled job's page: its state, its error code if it has one, a retry button, no viewer.
     page.goto(f"{server.url}/ui/jobs/{long.id}")
     page.wait_for_selector("#state")

@@ -91,12 +91,12 @@ function compactJson(v) {
 }
 
 function renderDetails(j) {
-  details.replaceChildren(
+  details.replaceChildren(...[
     el('h2', {}, 'Spec'), el('pre', { id: 'spec' }, compactJson(j.spec)),
     el('h2', {}, 'Timings per stage'), timings(j.result) || el('p', {}, j.state === 'succeeded' ? 'Not reported.' : 'When the job has succeeded.'),
     el('h2', {}, 'Metrics'), metrics(j.result) || el('p', {}, 'When the job has succeeded.'),
     el('h2', {}, 'Artifacts'), artifacts(j),
-    geometryImages(j));
+    geometryImages(j)].filter((x) => x));
 }
 
 /** A quad job's geometry and normal images (16-bit PNG), one row per mesh. */

@@ -111,6 +111,7 @@ def test_dashboard(server, browser, meshes):
     assert page.locator("table.timings tr").count() > 2
     assert page.locator("a.artifact", has_text="morph.glb").count() == 1
     assert "flipped_faces" in page.locator("table.metrics").inner_text()
+    assert "null" not in page.locator("#details").inner_text().split("metrics.json")[-1]
     cov = page.evaluate("window.surfmapViewer.coverage()")
     area = cov["width"] * cov["height"] / 2
     assert cov["left"] > 0.02 * area and cov["right"] > 0.02 * area, cov

@@ -141,10 +141,18 @@ pub fn metrics(
     serde_json::to_string_pretty(&r).map_err(|e| Error::Internal(e.to_string()))
 }
 
-/// Progress on stderr: a redrawn bar on a terminal, nothing otherwise.
+/// Progress on stderr: a redrawn bar (stage, percent, elapsed) on a terminal, nothing otherwise.
 struct StderrProgress {
     tty: bool,
     last: String,
+    start: std::time::Instant,
+}
+
+impl StderrProgress {
+    fn new() -> StderrProgress {
+        use std::io::IsTerminal;
+        StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new(), start: std::time::Instant::now() }
+    }
 }
 
 impl geom::progress::Progress for StderrProgress {
@@ -154,7 +162,15 @@ impl geom::progress::Progress for StderrProgress {
         }
         let f = fraction.clamp(0.0, 1.0);
         let filled = (f * 30.0).round() as usize;
-        let line = format!("\r{stage:<16} [{}{}] {:>3.0}%", "#".repeat(filled), " ".repeat(30 - filled), f * 100.0);
+        let secs = self.start.elapsed().as_secs();
+        let line = format!(
+            "\r{stage:<16} [{}{}] {:>3.0}%  {:02}:{:02}",
+            "#".repeat(filled),
+            " ".repeat(30 - filled),
+            f * 100.0,
+            secs / 60,
+            secs % 60
+        );
         if line != self.last {
             use std::io::Write;
             let mut e = std::io::stderr();
@@ -174,7 +190,6 @@ pub fn map(
     out: &Path,
 ) -> Result<String> {
     use geom::pipeline::{JobSpec, Method};
-    use std::io::IsTerminal;
     let read_bytes =
         |p: &Path| std::fs::read(p).map_err(|e| geom::InputError::Invalid(format!("cannot read {}: {e}", p.display())));
     let spec = match (spec, anchors) {
@@ -191,14 +206,13 @@ pub fn map(
         (None, None) => return Err(geom::InputError::Spec("give --anchors or --spec".into()).into()),
     };
     let (s, t) = (read_checked(source)?.0, read_checked(target)?.0);
-    let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
+    let mut progress = StderrProgress::new();
     let (report, artifacts) =
         geom::pipeline::run_with_layouts(&spec, &[s.mesh, t.mesh], &[s.layout, t.layout], &mut progress)?;
     finish(&progress, out, &artifacts, &report)
 }
 
 pub fn remesh(meshes: &[std::path::PathBuf], spec: &Path, out: &Path) -> Result<String> {
-    use std::io::IsTerminal;
     let bytes =
         std::fs::read(spec).map_err(|e| geom::InputError::Invalid(format!("cannot read {}: {e}", spec.display())))?;
     let spec = geom::pipeline::JobSpec::from_json(&bytes)?;
@@ -208,7 +222,7 @@ pub fn remesh(meshes: &[std::path::PathBuf], spec: &Path, out: &Path) -> Result<
         .collect::<Result<Vec<_>>>()?
         .into_iter()
         .unzip();
-    let mut progress = StderrProgress { tty: std::io::stderr().is_terminal(), last: String::new() };
+    let mut progress = StderrProgress::new();
     let (report, artifacts) = geom::pipeline::run_with_layouts(&spec, &models, &layouts, &mut progress)?;
     finish(&progress, out, &artifacts, &report)
 }

@@ -11,6 +11,7 @@ pub mod rest;
 pub mod serve;
 pub mod service;
 pub mod stopping;
+pub mod ui;
 pub mod views;
 
 use std::time::Duration;
@@ -49,7 +50,7 @@ pub fn app(state: AppState) -> axum::Router {
     let grpc = routes
         .into_axum_router()
         .layer(axum::middleware::map_response(grpc_decode::decode_failure_is_invalid_argument));
-    rest::router(state).merge(grpc.fallback(rest::not_found))
+    rest::router(state.clone()).merge(ui::router(state)).merge(grpc.fallback(rest::not_found))
 }
 
 /// Requeues expired leases every `period` until `shutdown`.

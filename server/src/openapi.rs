@@ -16,6 +16,8 @@ use crate::views::{
     ),
     paths(
         meshes::upload_mesh,
+        meshes::get_mesh,
+        meshes::get_mesh_glb,
         jobs::submit_job,
         jobs::list_jobs,
         jobs::get_job,

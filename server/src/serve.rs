@@ -149,6 +149,10 @@ async fn connection(
     tokio::pin!(served);
     let first_request = tokio::time::sleep(cfg.header_read_timeout);
     tokio::pin!(first_request);
+    // The first-request deadline is checked once, when it passes: a connection served by then
+    // keeps going (a `select!` branch's condition is read when the `select!` starts, so a
+    // request that arrives while it waits does not disable the branch).
+    let mut first_checked = false;
     let mut stopping = *stop.borrow();
     if stopping {
         served.as_mut().graceful_shutdown();
@@ -157,7 +161,12 @@ async fn connection(
         tokio::select! {
             _ = served.as_mut() => break,
             () = conn.close.notified() => break,
-            () = &mut first_request, if !conn.served.load(Ordering::SeqCst) => break,
+            () = &mut first_request, if !first_checked => {
+                first_checked = true;
+                if !conn.served.load(Ordering::SeqCst) {
+                    break;
+                }
+            }
             _ = stop.changed(), if !stopping => {
                 stopping = true;
                 if !conn.served.load(Ordering::SeqCst) {

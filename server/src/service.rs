@@ -203,6 +203,44 @@ impl JobService {
         })
     }
 
+    /// An uploaded mesh's record, as its owner sees it.
+    ///
+    /// # Errors
+    /// 400 `invalid_mesh_id` for a name that is not a sha256; 404 `mesh_not_found`.
+    pub async fn mesh(&self, owner: &str, id: &str) -> Result<MeshRecord, ApiError> {
+        if !BlobStore::valid_key(id) {
+            return Err(ApiError::bad_request("invalid_mesh_id", format!("{id:?} is not a mesh id (64 hex digits)")));
+        }
+        self.store
+            .get_mesh(owner, id)
+            .await?
+            .ok_or_else(|| ApiError::not_found("mesh_not_found", format!("no mesh {id:?}")))
+    }
+
+    /// An uploaded mesh as binary glTF in the file's own vertices (seam copies kept), so that
+    /// a spec's vertex ids index it; for viewers.
+    ///
+    /// # Errors
+    /// As [`JobService::mesh`]; 500 when its blob is missing.
+    pub async fn mesh_glb(&self, owner: &str, id: &str) -> Result<Vec<u8>, ApiError> {
+        let rec = self.mesh(owner, id).await?;
+        let bytes = self
+            .blobs
+            .get(id)
+            .await
+            .map_err(ApiError::internal)?
+            .ok_or_else(|| ApiError::internal(format!("blob of mesh {id} is missing")))?;
+        let hint = parse_format(Some(&rec.format)).ok().flatten();
+        let limits = MeshLimits { max_vertices: self.limits.max_vertices, max_faces: 2 * self.limits.max_vertices + 8 };
+        tokio::task::spawn_blocking(move || {
+            let r = geom::io::read(&bytes, &ReadOptions { limits, hint })?;
+            Ok::<_, geom::Error>(geom::io::write_layout_glb(&r.mesh, r.layout.as_ref(), &[]))
+        })
+        .await
+        .map_err(ApiError::internal)?
+        .map_err(ApiError::from)
+    }
+
     async fn summary(&self, owner: &str, role: &str, id: &str) -> Result<geom::topology::Summary, ApiError> {
         let m = self.store.get_mesh(owner, id).await?.ok_or_else(|| {
             ApiError::not_found(

@@ -50,6 +50,10 @@ pub struct JobView {
     pub attempts: i64,
     pub max_attempts: i64,
     pub method: String,
+    /// The job spec as validated (with every default filled in): submit it again with the
+    /// same meshes to retry.
+    #[schema(value_type = Object)]
+    pub spec: serde_json::Value,
     /// The job's meshes in the spec's order (source, target for a pair job).
     pub meshes: Vec<String>,
     /// The first and the last of `meshes`.
@@ -180,6 +184,7 @@ pub fn job_view(j: &JobRecord) -> JobView {
         attempts: j.attempts,
         max_attempts: j.max_attempts,
         method: j.method.clone(),
+        spec: serde_json::from_str(&j.spec).unwrap_or(serde_json::Value::Null),
         meshes: j.meshes.clone(),
         source: j.source.clone(),
         target: j.target.clone(),

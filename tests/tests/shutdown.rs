@@ -1,6 +1,6 @@
 //! The server against clients that hold on (issue 51): SIGTERM ends open SSE streams with a
 //! final event and exits within the grace period; half-sent requests are closed after the
-//! header read timeout; a crowd of slow connections leaves `/healthz` answering at once.
+//! header read timeout, streams are not; a crowd of slow connections leaves `/healthz` answering at once.
 
 mod common;
 
@@ -70,6 +70,35 @@ async fn sigterm_ends_an_open_sse_stream_and_exits_within_the_grace_period() {
     let status = server.wait_exit(Duration::from_secs(4)).unwrap_or_else(|| panic!("no exit within grace + 1 s"));
     assert!(status.success(), "{status:?}\n{}", server.log_text());
     assert!(t0.elapsed() < Duration::from_secs(4), "{:?}", t0.elapsed());
+}
+
+/// The header read timeout bounds a connection's first request, not a response it serves: an
+/// SSE stream opened at once stays open well past it (it used to be cut at that moment).
+#[tokio::test]
+async fn an_event_stream_outlives_the_header_read_timeout() {
+    let env = Env::sqlite();
+    let (_server, base) = env.server(&["--workers", "0", "--header-read-timeout-secs", "1"]);
+    let api = Api::new(&base);
+    let id = queued_job(&api).await;
+    let mut sse = TcpStream::connect(addr(&base)).unwrap();
+    write!(sse, "GET /v1/jobs/{id}/events HTTP/1.1\r\nHost: x\r\n\r\n").unwrap();
+    let mut buf = [0u8; 4096];
+    let n = sse.read(&mut buf).expect("the first event");
+    assert!(String::from_utf8_lossy(&buf[..n]).contains("200 OK"), "{}", String::from_utf8_lossy(&buf[..n]));
+    // Nothing more comes for 15 s (the keep-alive comment); 3.5 s of silence, not an end.
+    sse.set_read_timeout(Some(Duration::from_millis(3500))).unwrap();
+    let t0 = Instant::now();
+    loop {
+        match sse.read(&mut buf) {
+            Ok(0) => panic!("the stream was closed after {:?}", t0.elapsed()),
+            Ok(_) => continue,
+            Err(e) => {
+                assert!(matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut), "{e}");
+                break;
+            }
+        }
+    }
+    assert!(t0.elapsed() >= Duration::from_secs(3), "{:?}", t0.elapsed());
 }
 
 #[tokio::test]

@@ -1,13 +1,14 @@
 //! `POST /v1/meshes`: a raw body or a multipart file part.
 
-use super::{Owner, Q, is_multipart, multipart_error, read_limited, reserve_upload};
+use super::{Owner, P, Q, is_multipart, multipart_error, read_limited, reserve_upload};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
 use crate::service::format_hint;
 use crate::views::MeshView;
 use axum::Json;
 use axum::extract::{FromRequest, Multipart, Request, State};
-use axum::http::StatusCode;
+use axum::http::{StatusCode, header};
+use axum::response::{IntoResponse, Response};
 
 /// `?format=` for content that is ambiguous.
 #[derive(Debug, serde::Deserialize, utoipa::IntoParams)]
@@ -61,4 +62,32 @@ pub async fn upload_mesh(
     let hint = q.format.as_deref().or(ext);
     let view = st.service.upload_mesh(&owner, bytes, hint).await?;
     Ok((StatusCode::CREATED, Json(view)))
+}
+
+/// An uploaded mesh's id, format, size and summary.
+#[utoipa::path(get, path = "/v1/meshes/{id}", tag = "meshes", params(("id" = String, Path, pattern = "^[0-9a-f]{64}$")),
+    responses((status = 200, description = "the mesh", body = MeshView), (status = 400, description = "not a mesh id", body = ErrorBody),
+        (status = 404, description = "unknown mesh", body = ErrorBody)))]
+pub async fn get_mesh(
+    State(st): State<AppState>,
+    Owner(owner): Owner,
+    P(id): P<String>,
+) -> Result<Json<MeshView>, ApiError> {
+    let rec = st.service.mesh(&owner, &id).await?;
+    let summary = serde_json::from_str(&rec.summary).unwrap_or(serde_json::Value::Null);
+    Ok(Json(MeshView { id: rec.id, format: rec.format, size_bytes: rec.size_bytes, summary, warnings: Vec::new() }))
+}
+
+/// The mesh as binary glTF (`model/gltf-binary`) in the file's own vertices, so a spec's
+/// vertex ids index it (for viewers such as the dashboard's).
+#[utoipa::path(get, path = "/v1/meshes/{id}/glb", tag = "meshes", params(("id" = String, Path, pattern = "^[0-9a-f]{64}$")),
+    responses((status = 200, content_type = "model/gltf-binary", description = "the mesh as glTF 2.0 binary"),
+        (status = 400, description = "not a mesh id", body = ErrorBody), (status = 404, description = "unknown mesh", body = ErrorBody)))]
+pub async fn get_mesh_glb(
+    State(st): State<AppState>,
+    Owner(owner): Owner,
+    P(id): P<String>,
+) -> Result<Response, ApiError> {
+    let glb = st.service.mesh_glb(&owner, &id).await?;
+    Ok(([(header::CONTENT_TYPE, "model/gltf-binary")], glb).into_response())
 }

@@ -125,6 +125,8 @@ pub fn router(state: AppState) -> Router {
     let limit = state.service.limits.max_body_bytes;
     Router::new()
         .route("/v1/meshes", post(meshes::upload_mesh))
+        .route("/v1/meshes/{id}", get(meshes::get_mesh))
+        .route("/v1/meshes/{id}/glb", get(meshes::get_mesh_glb))
         .route("/v1/jobs", post(jobs::submit_job).get(jobs::list_jobs))
         .route("/v1/jobs/{id}", get(jobs::get_job))
         .route("/v1/jobs/{id}/cancel", post(jobs::cancel_job))

@@ -337,3 +337,24 @@ impl Api {
         (r.status().as_u16(), r.bytes().await.map(|b| b.to_vec()).unwrap_or_default(), ct)
     }
 }
+
+/// Runs pytest on `dir` (relative to the workspace) with the server binary and the client's
+/// source on the path; fails with pytest's output.
+pub fn pytest(dir: &str, extra: &[&str]) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = Command::new("python3")
+        .args(["-m", "pytest", "-q", "-p", "no:cacheprovider", dir])
+        .args(extra)
+        .current_dir(&root)
+        .env("SURFMAP_SERVER_BIN", binary("surfmap-server"))
+        .env("PYTHONPATH", root.join("clients/python/src"))
+        .output()
+        .expect("python3");
+    let (so, se) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    println!("{so}");
+    assert!(
+        out.status.success(),
+        "pytest {dir} failed (scripts/test-setup.sh installs pytest, httpx, playwright and chromium):\n{so}\n{se}"
+    );
+    assert!(so.contains(" passed"), "pytest ran no test:\n{so}");
+}

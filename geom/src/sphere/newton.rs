@@ -83,16 +83,16 @@ impl SphereImage for OnSphere {
 /// bird 5 and 2 evaluator flips with none seen.)
 fn upright<I: SphereImage>(image: &I, s: &[P3], tri: [u32; 3], images: [&Image; 3]) -> bool {
     let n = (images[1].x - images[0].x).cross(&(images[2].x - images[0].x));
-    let up: V3 = (0..3)
-        .map(|k| {
-            if !images[k].at_vertex {
-                return images[k].up;
-            }
-            let [a, b, c] = [k, (k + 1) % 3, (k + 2) % 3].map(|i| s[tri[i] as usize].coords);
-            image.up_at(tri[k], &P3::from((a * (1.0 - 2.0 * CORNER_INSET) + (b + c) * CORNER_INSET).normalize()))
-        })
-        .sum();
-    n.dot(&up) > 0.0
+    n.dot(&(0..3).map(|k| corner_up(image, s, tri, images, k)).sum()) > 0.0
+}
+
+/// The surface normal under corner `k` of triangle `tri` ([`upright`]).
+fn corner_up<I: SphereImage>(image: &I, s: &[P3], tri: [u32; 3], images: [&Image; 3], k: usize) -> V3 {
+    if !images[k].at_vertex {
+        return images[k].up;
+    }
+    let [a, b, c] = [k, (k + 1) % 3, (k + 2) % 3].map(|i| s[tri[i] as usize].coords);
+    image.up_at(tri[k], &P3::from((a * (1.0 - 2.0 * CORNER_INSET) + (b + c) * CORNER_INSET).normalize()))
 }
 
 /// How far inside a corner, as a fraction of the way to the other corners, the face under a
@@ -135,10 +135,18 @@ pub fn projected_layout(x: [P3; 3], up: &V3) -> Option<([[f64; 2]; 3], [V3; 2])>
 impl Measure {
     /// The triangle's layout and axes as this measure sees it; `None` when refused.
     /// `upright` says whether the image is upright ([`upright`]).
-    fn layout(self, images: [&Image; 3], upright: impl Fn() -> bool) -> Option<([[f64; 2]; 3], [V3; 2])> {
+    /// `frozen`, when given, is the normal an [`Measure::Untangle`] projection is taken on (a
+    /// line search holds the normals of its start, so the energy it searches is the one the
+    /// Newton step was computed for).
+    fn layout(
+        self,
+        images: [&Image; 3],
+        upright: impl Fn() -> bool,
+        frozen: Option<&V3>,
+    ) -> Option<([[f64; 2]; 3], [V3; 2])> {
         match self {
             Measure::Upright => upright().then(|| chord_layout(images.map(|i| i.x))).flatten(),
-            Measure::Untangle(_) => projected_layout(images.map(|i| i.x), &smooth_up(images)),
+            Measure::Untangle(_) => projected_layout(images.map(|i| i.x), frozen.unwrap_or(&smooth_up(images))),
         }
     }
 
@@ -323,6 +331,17 @@ impl SphereNewton {
     /// The energy under `measure`; `None` when a triangle is not positive on the sphere or the
     /// measure refuses an image.
     pub fn energy_as<I: SphereImage>(&self, measure: Measure, image: &I, s: &[P3]) -> Option<f64> {
+        self.energy_with(measure, image, s, None)
+    }
+
+    /// Per triangle, the normal [`Measure::Untangle`] projects its image on at `s`.
+    fn projection_normals<I: SphereImage>(&self, image: &I, s: &[P3]) -> Option<Vec<V3>> {
+        let (_, images) = Self::images(image, s)?;
+        Some(self.triangles.par_iter().map(|tri| smooth_up(tri.map(|v| &images[v as usize]))).collect())
+    }
+
+    /// [`SphereNewton::energy_as`] with the projections on `frozen` normals when given.
+    fn energy_with<I: SphereImage>(&self, measure: Measure, image: &I, s: &[P3], frozen: Option<&[V3]>) -> Option<f64> {
         let (_, images) = Self::images(image, s)?;
         let e: f64 = (0..self.triangles.len())
             .into_par_iter()
@@ -338,7 +357,7 @@ impl SphereNewton {
                 }
                 let im = tri.map(|v| &images[v as usize]);
                 let e = measure
-                    .layout(im, || upright(image, s, tri, im))
+                    .layout(im, || upright(image, s, tri, im), frozen.map(|f| &f[t]))
                     .and_then(|(x, _)| measure.energy(&self.rest[t], x));
                 e.map_or(f64::INFINITY, |e| e + guard)
             })
@@ -469,7 +488,7 @@ impl SphereNewton {
             .map(|t| {
                 let tri = self.triangles[t];
                 let im = tri.map(|v| &images[v as usize]);
-                let (x, [u, w]) = measure.layout(im, || upright(image, s, tri, im))?;
+                let (x, [u, w]) = measure.layout(im, || upright(image, s, tri, im), None)?;
                 let m: [Mat2; 3] = tri.map(|v| {
                     let a = &images[v as usize].d;
                     [[u.dot(&a[0]), u.dot(&a[1])], [w.dot(&a[0]), w.dot(&a[1])]]
@@ -574,6 +593,17 @@ impl SphereNewton {
         if slope >= 0.0 {
             return None;
         }
+        // The untangling energy searched with the projection normals of the start: the Newton
+        // step treats them as constant, and the normals moving under the step made it look
+        // like no descent (steps accepted after 40 halvings, plane -> bird).
+        let frozen = match measure {
+            Measure::Untangle(_) => Some(self.projection_normals(image, s)?),
+            Measure::Upright => None,
+        };
+        let energy = match &frozen {
+            Some(f) => self.energy_with(measure, image, s, Some(f))?,
+            None => energy,
+        };
         let longest = dir.iter().map(|d| d.norm()).fold(0.0, f64::max);
         let mut t = if longest > 0.0 { (opts.max_move / longest).min(1.0) } else { 1.0 };
         let first = (0..self.triangles.len())
@@ -590,7 +620,7 @@ impl SphereNewton {
         tracing::trace!(t, first, longest, "sphere line search");
         while t > 1e-14 {
             let trial: Vec<P3> = s.par_iter().zip(dir).map(|(p, d)| P3::from((p.coords + d * t).normalize())).collect();
-            if let Some(e) = self.energy_as(measure, image, &trial)
+            if let Some(e) = self.energy_with(measure, image, &trial, frozen.as_deref())
                 && e <= energy + 1e-4 * t * slope
                 && e < energy
                 && all_positive(&trial, &self.triangles)

@@ -16,7 +16,8 @@
 //! numerical failure, never returned as a folded or inexact map.
 
 use super::max_step::first_inversion;
-use super::newton::{OnSphere, SphereNewton, SphereNewtonOptions};
+use super::measure::OnSphere;
+use super::newton::{SphereNewton, SphereNewtonOptions};
 use super::orient::orient;
 use crate::error::{Error, Result};
 use crate::mesh::{P3, V3};

@@ -9,7 +9,7 @@
 //! across the edge whose determinant is negative, rotating which edge is tried first so it
 //! cannot cycle on a non-Delaunay triangulation, with a scan of every face as the last resort.
 
-use super::newton::{Image, SphereImage};
+use super::measure::{Image, SphereImage};
 use crate::mesh::{HalfedgeId, Mesh, P3, V3};
 use std::sync::atomic::{AtomicU32, Ordering};
 

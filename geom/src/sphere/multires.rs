@@ -12,7 +12,8 @@
 
 use super::barrier::barrier;
 use super::kernel::kernel_candidates;
-use super::newton::{OnSphere, SphereNewton, SphereNewtonOptions, SphereNewtonResult, chord_layout};
+use super::measure::{OnSphere, chord_layout};
+use super::newton::{SphereNewton, SphereNewtonOptions, SphereNewtonResult};
 use super::orient::orient;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, P3};

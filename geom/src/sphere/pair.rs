@@ -27,8 +27,9 @@
 use super::align::fit_rotation;
 use super::landmarks::{LandmarkReport, place_anchors};
 use super::locate::{Located, OnTarget, SphereLocator};
+use super::measure::Measure;
 use super::multires::rest_on_unit_sphere;
-use super::newton::{Measure, SphereNewton, SphereNewtonOptions, SphereNewtonResult};
+use super::newton::{SphereNewton, SphereNewtonOptions, SphereNewtonResult};
 use super::orient::check;
 use super::untangle::UntangleResult;
 use crate::error::{Error, InputError, Result};

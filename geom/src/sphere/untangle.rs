@@ -11,7 +11,8 @@
 //! injective Newton steps as [`SphereNewton::minimize`]: the spherical triangulation stays
 //! bijective throughout; only the images on the surface are untangled.
 
-use super::newton::{Measure, SphereImage, SphereNewton, SphereNewtonOptions};
+use super::measure::{Measure, SphereImage};
+use super::newton::{SphereNewton, SphereNewtonOptions};
 use crate::error::Result;
 use crate::mesh::P3;
 use crate::progress::Progress;

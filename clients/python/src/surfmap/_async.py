@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import asyncio
-import json
 import os
 import pathlib
 import time
@@ -11,9 +10,10 @@ from typing import Any, AsyncIterator, Dict, List, Optional, Sequence, Tuple, Un
 
 import httpx
 
-from ._client import DEFAULT_URL, Progress, _headers, _raise_for_end, _Reporter, _spec_of, _timeout
+from ._client import (DEFAULT_URL, _END, Progress, _headers, _job_event, _raise_for_end, _Reporter, _spec_of,
+                      _timeout, _wanted)
 from ._endpoints import path as endpoint
-from ._errors import SurfmapError, Timeout, from_response
+from ._errors import Timeout, from_response
 from ._mesh import is_mesh_id, mesh_input
 from ._models import Artifact, JobData, Mesh, SseParser
 
@@ -153,14 +153,11 @@ class AsyncClient:
                 raise from_response(r.status_code, r.content, r.headers)
             sse = SseParser()
             async for line in r.aiter_lines():
-                ev = sse.feed(line)
-                if ev is None:
-                    continue
-                name, data = ev
-                if name == "job":
-                    yield AsyncJob(self, json.loads(data))
-                elif name == "shutdown":
+                ev = _job_event(sse, line)
+                if ev is _END:
                     return
+                if ev is not None:
+                    yield AsyncJob(self, ev)
 
     async def wait(self, job_id: str, timeout: Optional[float] = None, progress: Progress = None,
                    raise_on_failure: bool = True) -> AsyncJob:
@@ -202,10 +199,7 @@ class AsyncClient:
         out = pathlib.Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         listed = list(artifacts) if artifacts is not None else await self.artifacts(job_id)
-        wanted = [a.name for a in listed] if names is None else list(names)
-        missing = [n for n in wanted if n not in {a.name for a in listed}]
-        if missing:
-            raise SurfmapError("artifact_not_found", f"job {job_id} has no artifact {missing[0]!r}")
+        wanted = _wanted(job_id, listed, names)
         paths = []
         for name in wanted:
             p = out / name

@@ -70,6 +70,31 @@ def _raise_for_end(job: JobData, raise_on_failure: bool) -> None:
         raise JobCancelled("cancelled", f"job {job.id} was cancelled", job=job)
 
 
+_END = object()
+
+
+def _job_event(sse: SseParser, line: str) -> Any:
+    """The job data an event-stream line completes, ``_END`` on the server's shutdown event,
+    else None."""
+    ev = sse.feed(line)
+    if ev is None:
+        return None
+    name, data = ev
+    if name == "job":
+        return json.loads(data)
+    return _END if name == "shutdown" else None
+
+
+def _wanted(job_id: str, listed: Sequence[Artifact], names: Optional[Sequence[str]]) -> List[str]:
+    """The artifact names to download (all, or ``names``), refused when one is not listed."""
+    wanted = [a.name for a in listed] if names is None else list(names)
+    known = {a.name for a in listed}
+    missing = [n for n in wanted if n not in known]
+    if missing:
+        raise SurfmapError("artifact_not_found", f"job {job_id} has no artifact {missing[0]!r}")
+    return wanted
+
+
 def _spec_of(spec: Any) -> Dict[str, Any]:
     if isinstance(spec, (str, os.PathLike)) and os.path.exists(spec):
         with open(spec, encoding="utf-8") as fh:
@@ -235,14 +260,11 @@ class Client:
                 raise from_response(r.status_code, r.content, r.headers)
             sse = SseParser()
             for line in r.iter_lines():
-                ev = sse.feed(line)
-                if ev is None:
-                    continue
-                name, data = ev
-                if name == "job":
-                    yield Job(self, json.loads(data))
-                elif name == "shutdown":
+                ev = _job_event(sse, line)
+                if ev is _END:
                     return
+                if ev is not None:
+                    yield Job(self, ev)
 
     def wait(self, job_id: str, timeout: Optional[float] = None, progress: Progress = None,
              raise_on_failure: bool = True) -> Job:
@@ -288,11 +310,7 @@ class Client:
         out = pathlib.Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         listed = list(artifacts) if artifacts is not None else self.artifacts(job_id)
-        wanted = [a.name for a in listed] if names is None else list(names)
-        known = {a.name for a in listed}
-        missing = [n for n in wanted if n not in known]
-        if missing:
-            raise SurfmapError("artifact_not_found", f"job {job_id} has no artifact {missing[0]!r}")
+        wanted = _wanted(job_id, listed, names)
         paths = []
         for name in wanted:
             p = out / name

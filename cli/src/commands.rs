@@ -199,7 +199,8 @@ pub fn map(
                 "greedy" => Method::Greedy,
                 "homology" => Method::Homology,
                 "spherical" => Method::Spherical,
-                _ => Method::Voronoi,
+                "voronoi" => Method::Voronoi,
+                _ => Method::Auto,
             };
             JobSpec::from_anchors_json(&read_bytes(a)?, m)?
         }

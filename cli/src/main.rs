@@ -63,11 +63,12 @@ enum Command {
         /// JSON `{"anchors": [[source_vertex, target_vertex], ...]}` (0-based); method from --method.
         #[arg(long, conflicts_with = "spec", required_unless_present = "spec")]
         anchors: Option<PathBuf>,
-        /// The job spec `{"method": "voronoi"|"greedy"|"homology"|"spherical", "anchors": [[s, t], ...], "options": {...}}`.
+        /// The job spec `{"method": "auto"|"voronoi"|"greedy"|"homology"|"spherical", "anchors": [[s, t], ...], "options": {...}}`
+        /// (without `method`: auto, the method that fits the meshes).
         #[arg(long)]
         spec: Option<PathBuf>,
-        /// Method when --anchors is given.
-        #[arg(long, default_value = "voronoi", value_parser = ["voronoi", "greedy", "homology", "spherical"])]
+        /// Method when --anchors is given (auto: the one that fits the meshes).
+        #[arg(long, default_value = "auto", value_parser = ["auto", "voronoi", "greedy", "homology", "spherical"])]
         method: String,
         /// Output directory (created if missing).
         #[arg(long)]

@@ -86,7 +86,7 @@ pub struct JobService {
 }
 
 /// The methods a job may name, in the order the docs list them.
-pub const METHODS: [&str; 5] = geom::pipeline::METHODS;
+pub const METHODS: [&str; 6] = geom::pipeline::METHODS;
 
 fn parse_format(hint: Option<&str>) -> Result<Option<Format>, ApiError> {
     Ok(match hint.map(str::to_ascii_lowercase).as_deref() {

@@ -148,9 +148,10 @@ pub struct MeshesJobRequest {
 #[derive(Debug, ToSchema)]
 #[allow(dead_code)]
 pub struct SpecOutline {
-    /// voronoi | greedy | homology | quad | spherical
-    #[schema(pattern = "^(voronoi|greedy|homology|quad|spherical)$")]
-    method: String,
+    /// voronoi | greedy | homology | quad | spherical | auto; left out, `auto`: the service
+    /// picks the pair method that fits the meshes, and `metrics.json`'s `auto` says which and why.
+    #[schema(pattern = "^(voronoi|greedy|homology|quad|spherical|auto)$")]
+    method: Option<String>,
     /// Rows: `[source, target]` vertex ids for pair jobs (or `{"source": [x, y, z], "target":
     /// [x, y, z]}`, or `{"source": {"face": f, "bary": [u, v, w]}, "target": ...}` surface
     /// points); one id per mesh for `quad`.

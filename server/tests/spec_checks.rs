@@ -83,3 +83,21 @@ async fn a_transfer_of_a_missing_attribute_is_refused_before_queueing() {
     let (_, page) = json_call(&t, "GET", "/v1/jobs", Body::empty()).await;
     assert_eq!(page["jobs"], json!([]), "nothing was queued");
 }
+
+/// A spec without `method` is an `auto` job: queued as such, and the chosen method's checks
+/// apply at submission (here `spherical`'s 3 anchors).
+#[tokio::test]
+async fn a_spec_without_method_is_queued_as_auto_and_checked_as_the_method_it_picks() {
+    let t = setup().await;
+    let ids = upload_spheres(&t, 2).await;
+    let spec = json!({"anchors": [[0, 0], [5, 5], [9, 9]], "options": {"metric_samples": 1000}});
+    let (st, job) = json_call(&t, "POST", "/v1/jobs", json!({"meshes": ids, "spec": spec}).to_string()).await;
+    assert!(st.is_success(), "{st} {job}");
+    assert_eq!(job["method"], "auto", "{job}");
+    let spec = json!({"method": "auto", "anchors": [[0, 0], [5, 5], [9, 9]], "options": {"smoothing": {}}});
+    let (st, e) = json_call(&t, "POST", "/v1/jobs", json!({"meshes": ids, "spec": spec}).to_string()).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::BAD_REQUEST, Some("invalid_spec")), "{e}");
+    let spec = json!({"anchors": [[0, 0], [5, 5], [9, 99999]]});
+    let (st, e) = json_call(&t, "POST", "/v1/jobs", json!({"meshes": ids, "spec": spec}).to_string()).await;
+    assert_eq!((st, e["code"].as_str()), (StatusCode::UNPROCESSABLE_ENTITY, Some("invalid_anchors")), "{e}");
+}

@@ -45,6 +45,7 @@ fn rows_mut(spec: &mut JobSpec) -> Option<&mut Vec<AnchorRow>> {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => Some(&mut s.anchors),
         JobSpec::Homology(s) => Some(&mut s.anchors),
         JobSpec::Spherical(s) => Some(&mut s.anchors),
+        JobSpec::Auto(s) => Some(&mut s.anchors),
         JobSpec::Quad(_) => None,
     }
 }

@@ -43,6 +43,8 @@ impl JobSpec {
                 s.check(a, b)?;
                 &s.options.transfer
             }
+            // The chosen method's checks, as if it had been named.
+            JobSpec::Auto(s) => return s.resolve(summaries)?.0.check(summaries),
         };
         // The attributes `transfer` carries, when the source's summary records them.
         match summaries.first().and_then(|s| s.attribute_names.as_deref()) {

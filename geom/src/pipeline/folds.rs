@@ -117,6 +117,7 @@ fn spec_anchors(spec: &JobSpec) -> Vec<[u64; 2]> {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
         JobSpec::Homology(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
         JobSpec::Spherical(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
+        JobSpec::Auto(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
         JobSpec::Quad(_) => Vec::new(),
     }
 }

@@ -5,7 +5,8 @@
 //! [`InputLayout::welded`]; other inputs' ids are the mesh's already.
 
 use super::anchor_spec::AnchorRow;
-use super::spec::JobSpec;
+use super::auto::AutoSpec;
+use super::spec::{HomologySpec, JobSpec};
 use crate::error::{InputError, Result};
 use crate::mesh::InputLayout;
 use crate::mesh::layout::VertexIds;
@@ -58,9 +59,10 @@ pub fn to_welded<'a>(spec: &'a JobSpec, layouts: &[Option<&InputLayout>]) -> Res
             }
         }
         JobSpec::Spherical(x) => id_rows(&mut x.anchors, &table)?,
-        JobSpec::Homology(h) => {
-            id_rows(&mut h.anchors, &table)?;
-            for f in &mut h.features {
+        JobSpec::Homology(HomologySpec { anchors, features, .. })
+        | JobSpec::Auto(AutoSpec { anchors, features, .. }) => {
+            id_rows(anchors, &table)?;
+            for f in features {
                 for id in &mut f.source {
                     map_id(id, table(0), 0)?;
                 }

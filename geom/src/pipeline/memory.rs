@@ -46,6 +46,9 @@ impl JobSpec {
                 .saturating_add(PER_SAMPLE.saturating_mul(2 * samples as u64))
         };
         let bytes = match self {
+            JobSpec::Auto(spec) => {
+                return spec.resolve(summaries).map_or(0, |(spec, _)| spec.memory_estimate(summaries));
+            }
             JobSpec::Voronoi(spec) | JobSpec::Greedy(spec) => pair(&spec.options.layout, spec.options.metric_samples),
             // Two embeddings, their hierarchies and the Newton systems: per vertex, as a layout.
             JobSpec::Spherical(spec) => pair(&Default::default(), spec.options.metric_samples),

@@ -8,6 +8,7 @@
 
 mod anchor_points;
 mod anchor_spec;
+mod auto;
 mod check;
 pub mod common;
 pub mod features;
@@ -32,6 +33,7 @@ mod transfer_output;
 pub mod voronoi;
 
 pub use anchor_spec::{AnchorPoints, AnchorRow, FacePoint, PointRef};
+pub use auto::{AutoChoice, AutoOptions, AutoSpec};
 pub use common::{Artifact, PairReport};
 pub use limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_FEATURES, MAX_METRIC_SAMPLES, MAX_MODELS, MAX_MORPH_FRAMES};
 pub use quad::{QuadReport, Remeshes, remesh_all_for_bench};
@@ -117,12 +119,22 @@ pub fn run_with_layouts(
     progress: &mut dyn Progress,
 ) -> Result<(JobReport, Vec<Artifact>)> {
     let layouts: Vec<Option<&InputLayout>> = layouts.iter().map(Option::as_ref).collect();
+    let (chosen, auto) = match spec {
+        JobSpec::Auto(a) => {
+            let summaries: Vec<_> = meshes.iter().map(crate::topology::summary).collect();
+            let (spec, why) = a.resolve(&summaries)?;
+            (Some(spec), Some(why))
+        }
+        _ => (None, None),
+    };
+    let spec = chosen.as_ref().unwrap_or(spec);
     let spec = &*input_ids::to_welded(spec, &layouts)?;
     let originals = meshes;
     let transfer = match spec {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => transfer_output::parse(&s.options.transfer)?,
         JobSpec::Homology(s) => transfer_output::parse(&s.options.transfer)?,
         JobSpec::Spherical(s) => transfer_output::parse(&s.options.transfer)?,
+        JobSpec::Auto(s) => transfer_output::parse(&s.options.transfer)?,
         JobSpec::Quad(_) => Default::default(),
     };
     let wants_transfer = !transfer.texcoords.is_empty() || transfer.color || transfer.skin;
@@ -142,11 +154,16 @@ pub fn run_with_layouts(
         pair.anchor_points = r.snaps.clone();
         common::rewrite_metrics(&mut arts, &report)?;
     }
+    if let (Some(why), Some(pair)) = (auto, report.pair_mut()) {
+        pair.auto = Some(why);
+        common::rewrite_metrics(&mut arts, &report)?;
+    }
     folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
     let inverse = match spec {
         JobSpec::Voronoi(s) | JobSpec::Greedy(s) => s.options.inverse_morph,
         JobSpec::Homology(s) => s.options.inverse_morph,
         JobSpec::Spherical(s) => s.options.inverse_morph,
+        JobSpec::Auto(s) => s.options.inverse_morph,
         JobSpec::Quad(_) => false,
     };
     layout_outputs::add_morph(&report, (originals, meshes), &layouts, inverse, &mut arts);
@@ -191,6 +208,7 @@ fn dispatch(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Res
             let (r, arts) = spherical::run(s, a, b, progress)?;
             (JobReport::Spherical(r), arts)
         }
+        JobSpec::Auto(_) => return Err(crate::Error::Internal("an auto job reached dispatch unresolved".into())),
     })
 }
 
@@ -282,7 +300,11 @@ mod spec_tests {
         assert!(e.to_string().contains("basis"), "{e}");
         let e = JobSpec::from_json(br#"{"method": "greedy", "anchors": [], "features": []}"#).unwrap_err();
         assert!(e.to_string().contains("features"), "{e}");
-        let e = JobSpec::from_json(br#"{"anchors": []}"#).unwrap_err();
+        // Without a method the service picks one; its fields are still checked.
+        let spec = JobSpec::from_json(br#"{"anchors": []}"#).unwrap();
+        assert_eq!(spec.method(), Method::Auto);
+        let e = JobSpec::from_json(br#"{"anchors": [], "basis": [0, 0]}"#).unwrap_err();
         assert_eq!(e.code(), "invalid_spec");
+        assert!(e.to_string().contains("basis"), "{e}");
     }
 }

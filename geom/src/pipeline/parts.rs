@@ -167,6 +167,7 @@ pub fn run(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Resu
         JobSpec::Voronoi(x) | JobSpec::Greedy(x) => x.options.metric_samples,
         JobSpec::Homology(x) => x.options.metric_samples,
         JobSpec::Spherical(x) => x.options.metric_samples,
+        JobSpec::Auto(x) => x.options.metric_samples,
         JobSpec::Quad(_) => 100_000,
     };
     let mo = MetricsOptions { samples, ..Default::default() };
@@ -212,6 +213,10 @@ fn with_anchors(spec: &JobSpec, anchors: Vec<AnchorRow>, boundaries: Vec<[u64; 2
             x.options.inverse_morph = false;
         }
         JobSpec::Spherical(x) => {
+            (x.anchors, x.options.transfer) = (anchors, Vec::new());
+            x.options.inverse_morph = false;
+        }
+        JobSpec::Auto(x) => {
             (x.anchors, x.options.transfer) = (anchors, Vec::new());
             x.options.inverse_morph = false;
         }

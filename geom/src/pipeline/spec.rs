@@ -4,10 +4,12 @@
 //! `{"method": "voronoi" | "greedy", "anchors": [[s, t], ...], "options": {...}}`,
 //! `{"method": "homology", "anchors": [...], "features": [...], "options": {...}}`,
 //! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}`,
-//! `{"method": "spherical", "anchors": [...], "options": {...}}`.
+//! `{"method": "spherical", "anchors": [...], "options": {...}}`,
+//! `{"method": "auto", "anchors": [...], "options": {...}}` (also without `method`).
 //! Each method has its own options type; unknown fields are refused at every depth.
 
 use super::anchor_spec::AnchorRow;
+use super::auto::{AutoOptions, AutoSpec};
 use super::quad_spec::QuadSpec;
 use crate::crossparam::PatchParamOptions;
 use crate::crossparam::smooth::SmoothOptions;
@@ -16,7 +18,7 @@ use crate::error::{Error, InputError, Result};
 use serde::{Deserialize, Serialize};
 
 /// Every method a job may name, in [`Method`] order.
-pub const METHODS: [&str; 5] = ["voronoi", "greedy", "homology", "quad", "spherical"];
+pub const METHODS: [&str; 6] = ["voronoi", "greedy", "homology", "quad", "spherical", "auto"];
 
 /// A job: its method, with that method's anchors and options.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -34,6 +36,9 @@ pub enum JobSpec {
     /// Closed genus-0 pairs through bijective sphere embeddings, one injective optimization
     /// (Schmidt, Pieper & Kobbelt 2023; issue 50).
     Spherical(SphericalSpec),
+    /// The pair method that fits the meshes, picked by the service ([`super::auto`]); also a
+    /// spec without `method`.
+    Auto(AutoSpec),
 }
 
 /// The method of a job.
@@ -44,6 +49,7 @@ pub enum Method {
     Homology,
     Quad,
     Spherical,
+    Auto,
 }
 
 impl Method {
@@ -265,7 +271,7 @@ impl JobSpec {
     /// Parses a spec: the one place JSON becomes a job.
     ///
     /// # Errors
-    /// `InputError::UnknownMethod` for a missing or unknown `"method"`; `InputError::Spec`
+    /// `InputError::UnknownMethod` for an unknown `"method"`; `InputError::Spec`
     /// naming the field at fault otherwise.
     pub fn from_json(bytes: &[u8]) -> Result<JobSpec> {
         let v: serde_json::Value =
@@ -286,7 +292,14 @@ impl JobSpec {
                 ))
                 .into());
             }
-            None => return Err(InputError::Spec("spec has no \"method\"".into()).into()),
+            None => {
+                // No method: the service picks one.
+                let mut v = v;
+                if let Some(o) = v.as_object_mut() {
+                    o.insert("method".into(), "auto".into());
+                }
+                return JobSpec::deserialize(v).map_err(|e| InputError::Spec(e.to_string()).into());
+            }
             _ => {}
         }
         JobSpec::deserialize(v).map_err(|e| InputError::Spec(e.to_string()).into())
@@ -322,6 +335,9 @@ impl JobSpec {
             Method::Spherical => {
                 Ok(JobSpec::Spherical(SphericalSpec { anchors, options: SphericalOptions::default() }))
             }
+            Method::Auto => {
+                Ok(JobSpec::Auto(AutoSpec { anchors, features: Vec::new(), options: AutoOptions::default() }))
+            }
         }
     }
 
@@ -332,6 +348,7 @@ impl JobSpec {
             JobSpec::Homology(_) => Method::Homology,
             JobSpec::Quad(_) => Method::Quad,
             JobSpec::Spherical(_) => Method::Spherical,
+            JobSpec::Auto(_) => Method::Auto,
         }
     }
 

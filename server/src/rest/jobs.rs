@@ -21,8 +21,8 @@ pub struct ListQuery {
     /// queued | running | succeeded | failed | cancelled
     #[param(pattern = "^(queued|running|succeeded|failed|cancelled)$")]
     pub state: Option<String>,
-    /// voronoi | greedy | homology | quad | spherical
-    #[param(pattern = "^(voronoi|greedy|homology|quad|spherical)$")]
+    /// voronoi | greedy | homology | quad | spherical | auto
+    #[param(pattern = "^(voronoi|greedy|homology|quad|spherical|auto)$")]
     pub method: Option<String>,
     /// `next_cursor` of the previous page (a job id).
     #[param(pattern = "^[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}$")]

@@ -94,6 +94,9 @@ pub struct PairReport {
     /// position, whether it was inserted.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub anchor_points: Vec<super::anchor_points::AnchorSnap>,
+    /// For a job that named no method (`auto`): the method that ran, and why.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub auto: Option<super::auto::AutoChoice>,
 }
 
 /// Both vertex maps of a pair job.
@@ -124,6 +127,7 @@ impl PairReport {
             inverted: None,
             maps: None,
             anchor_points: Vec::new(),
+            auto: None,
         }
     }
 

@@ -1,0 +1,161 @@
+//! `"method": "auto"`, and a spec without `method`: the service picks the pair method that fits
+//! the meshes, and `metrics.json` says which ran and why (`auto`).
+//!
+//! - Feature curves: `homology`, the one method that maps them.
+//! - Two connected closed genus-0 meshes with at least 3 anchors: `spherical` (bijective sphere
+//!   embeddings, one injective optimization).
+//! - Closed meshes of genus ≥ 1: `homology` (canonical homology bases).
+//! - Anything else (open or multi-part genus-0 meshes, fewer than 3 anchors): `voronoi`.
+//!
+//! The choice is made once, from the meshes' summaries; the chosen method's own checks then
+//! apply as if it had been named.
+
+use super::anchor_spec::AnchorRow;
+use super::spec::{
+    FeatureSpec, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, SphericalOptions, SphericalSpec,
+};
+use crate::error::{InputError, Result};
+use crate::topology::Summary;
+use serde::{Deserialize, Serialize};
+
+/// A job whose method the service picks.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AutoSpec {
+    pub anchors: Vec<AnchorRow>,
+    /// Corresponding feature curves (they pick `homology`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub features: Vec<FeatureSpec>,
+    #[serde(default)]
+    pub options: AutoOptions,
+}
+
+/// The options every pair method takes. Every field has a default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AutoOptions {
+    /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
+    pub metric_samples: usize,
+    /// Source attributes to carry onto the target (`target_transferred.glb`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub transfer: Vec<String>,
+    /// `morph.glb` also holds the target placed on the source (the inverse pair).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub inverse_morph: bool,
+}
+
+impl Default for AutoOptions {
+    fn default() -> Self {
+        Self { metric_samples: 100_000, transfer: Vec::new(), inverse_morph: false }
+    }
+}
+
+/// Which method an `auto` job ran, and why (`metrics.json`'s `auto`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AutoChoice {
+    pub method: &'static str,
+    pub reason: String,
+}
+
+impl AutoSpec {
+    /// The job as the method that fits the meshes (`summaries`: source, target), and why.
+    ///
+    /// # Errors
+    /// `InputError::Spec` unless there are two meshes.
+    pub fn resolve(&self, summaries: &[Summary]) -> Result<(JobSpec, AutoChoice)> {
+        let [s, t] = summaries else {
+            return Err(InputError::Spec(format!(
+                "method auto maps a source onto a target: 2 meshes, got {}",
+                summaries.len()
+            ))
+            .into());
+        };
+        let o = &self.options;
+        let homology = || {
+            JobSpec::Homology(HomologySpec {
+                anchors: self.anchors.clone(),
+                features: self.features.clone(),
+                options: HomologyOptions {
+                    metric_samples: o.metric_samples,
+                    transfer: o.transfer.clone(),
+                    inverse_morph: o.inverse_morph,
+                    ..HomologyOptions::default()
+                },
+            })
+        };
+        let closed_sphere = |m: &Summary| m.components == 1 && m.boundary_loops == 0 && m.genus == 0;
+        let (spec, reason) = if !self.features.is_empty() {
+            (homology(), "feature curves are mapped by homology".to_string())
+        } else if closed_sphere(s) && closed_sphere(t) && self.anchors.len() >= 3 {
+            let options = SphericalOptions {
+                metric_samples: o.metric_samples,
+                transfer: o.transfer.clone(),
+                inverse_morph: o.inverse_morph,
+            };
+            let spec = JobSpec::Spherical(SphericalSpec { anchors: self.anchors.clone(), options });
+            (spec, "two connected closed genus-0 meshes with at least 3 anchors".to_string())
+        } else if s.boundary_loops == 0 && t.boundary_loops == 0 && (s.genus >= 1 || t.genus >= 1) {
+            (homology(), format!("closed meshes of genus {} and {}", s.genus, t.genus))
+        } else {
+            let options = MapOptions {
+                metric_samples: o.metric_samples,
+                transfer: o.transfer.clone(),
+                inverse_morph: o.inverse_morph,
+                ..MapOptions::default()
+            };
+            let spec = JobSpec::Voronoi(LayoutSpec { anchors: self.anchors.clone(), boundaries: Vec::new(), options });
+            let why = format!(
+                "{} and {} components, {} and {} boundary loops, genus {} and {}, {} anchors",
+                s.components,
+                t.components,
+                s.boundary_loops,
+                t.boundary_loops,
+                s.genus,
+                t.genus,
+                self.anchors.len()
+            );
+            (spec, why)
+        };
+        let method = spec.method().name();
+        Ok((spec, AutoChoice { method, reason }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::shapes;
+    use crate::topology::summary;
+
+    fn auto(json: &str) -> AutoSpec {
+        match JobSpec::from_json(json.as_bytes()).unwrap() {
+            JobSpec::Auto(a) => a,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_spec_without_method_is_auto_and_picks_by_topology() {
+        let sphere = summary(&shapes::icosphere(2));
+        let torus = summary(&shapes::torus(8, 6, 2.0, 0.5));
+        let a = auto(r#"{"anchors": [[0, 0], [5, 5], [9, 9]], "options": {"metric_samples": 500}}"#);
+        let (spec, why) = a.resolve(&[sphere.clone(), sphere.clone()]).unwrap();
+        assert_eq!(why.method, "spherical", "{why:?}");
+        let JobSpec::Spherical(s) = spec else { panic!("{spec:?}") };
+        assert_eq!(s.options.metric_samples, 500, "the shared options carry over");
+        let (spec, why) = a.resolve(&[torus.clone(), torus]).unwrap();
+        assert_eq!((spec.method().name(), why.method), ("homology", "homology"));
+        let two = auto(r#"{"method": "auto", "anchors": [[0, 0], [5, 5]]}"#);
+        let (_, why) = two.resolve(&[sphere.clone(), sphere.clone()]).unwrap();
+        assert_eq!(why.method, "voronoi", "fewer than 3 anchors: {why:?}");
+        let err = a.resolve(&[sphere]).unwrap_err();
+        assert_eq!(err.code(), "invalid_spec");
+    }
+
+    #[test]
+    fn an_option_no_shared_method_takes_is_refused() {
+        let e = JobSpec::from_json(br#"{"anchors": [[0, 0]], "options": {"layout": {}}}"#).unwrap_err();
+        assert_eq!(e.code(), "invalid_spec");
+        assert!(e.to_string().contains("layout"), "{e}");
+    }
+}

@@ -1,13 +1,12 @@
 //! Method `quad` (Yu & Chuang Table 1): consistent parameterization of a pair (SMPL man and
-//! woman, 6890 vertices each, 4 partition points and 6 features), uniform remeshing at level 8
-//! of that pair, and a single bunny job at level 6 as `surfmap remesh` runs it.
+//! woman, 6890 vertices each, 4 partition points and 6 features) and a single bunny job at level 6 as `surfmap remesh` runs it.
 //! `cargo bench -p surfmap-geom --bench quad`
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use geom::io::{ReadOptions, read_path};
 use geom::mesh::{Mesh, VertexId};
+use geom::pipeline::JobSpec;
 use geom::pipeline::quad::run as run_remesh;
-use geom::pipeline::{JobSpec, remesh_all_for_bench};
 use geom::progress::NoProgress;
 use geom::quad::consistent::{ConsistentOptions, consistent_parameterization};
 
@@ -29,8 +28,6 @@ fn bench(c: &mut Criterion) {
     g.bench_function("smpl_pair_parameterize", |b| {
         b.iter(|| consistent_parameterization(&[&man, &woman], &rows, &o, &mut NoProgress).expect("param"))
     });
-    let cp = consistent_parameterization(&[&man, &woman], &rows, &o, &mut NoProgress).expect("param");
-    g.bench_function("smpl_pair_remesh_level8", |b| b.iter(|| remesh_all_for_bench(&cp, 8).expect("remesh")));
     let bunny = load("bunny.off");
     let ids = fps(&bunny, 4);
     let JobSpec::Quad(spec) = JobSpec::from_json(

@@ -1,12 +1,15 @@
 //! The OpenAPI document, derived from the handlers' annotations (utoipa), with the bearer
 //! security scheme and the 401 answers of the routes that take a token added here.
 
+use crate::AppState;
 use crate::error::ErrorBody;
 use crate::rest::{artifacts, jobs, meshes, ops};
 use crate::views::{
     ArtifactList, ArtifactView, JobLinks, JobPage, JobView, MeshView, MeshesJobRequest, PairJobRequest, SpecOutline,
     SubmitJobRequest,
 };
+use axum::Json;
+use axum::extract::State;
 
 #[derive(utoipa::OpenApi)]
 #[openapi(
@@ -28,7 +31,7 @@ use crate::views::{
         ops::healthz,
         ops::readyz,
         ops::metrics,
-        ops::openapi
+        serve
     ),
     components(schemas(
         ErrorBody,
@@ -72,4 +75,10 @@ pub fn document(auth_required: bool) -> serde_json::Value {
         }
     }
     doc
+}
+
+/// The OpenAPI 3.1 document of this API.
+#[utoipa::path(get, path = "/openapi.json", tag = "ops", responses((status = 200, description = "OpenAPI document")))]
+pub async fn serve(State(st): State<AppState>) -> Json<serde_json::Value> {
+    Json(document(st.auth.enabled()))
 }

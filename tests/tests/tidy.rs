@@ -2,8 +2,9 @@
 //!
 //! Fails on: a Rust source file over [`MAX_FILE_LINES`] lines or a function over
 //! [`MAX_FN_LINES`] lines that is not on its allow-list; a tolerance literal (`1e-9`, ...)
-//! outside `geom/src/tol.rs` beyond a file's allowance; ARCHITECTURE.md over 32 KiB or naming a
-//! path that does not exist. The allow-lists record what exists today and may only shrink: an
+//! outside `geom/src/tol.rs` beyond a file's allowance; a file-level import cycle in any crate
+//! that is not on its list ([`imports`]); ARCHITECTURE.md over 32 KiB or naming a path that does
+//! not exist. The allow-lists record what exists today and may only shrink: an
 //! entry that is no longer needed (the file or function got small, a literal moved into
 //! `tol.rs`) fails the test too, so that whoever fixed it also removes the entry.
 
@@ -222,4 +223,66 @@ fn the_checks_catch_what_they_are_for() {
     assert_eq!(against("file", "x", &found, &[("a", 4)]).len(), 1, "a shrunk entry must be lowered");
     assert_eq!(against("file", "x", &found, &[]).len(), 1, "a new violation fails");
     assert_eq!(against("file", "x", &BTreeMap::new(), &[("a", 3)]).len(), 1, "a stale entry fails");
+}
+
+#[path = "tidy/imports.rs"]
+mod imports;
+
+/// File-level import cycles that exist today (each the sorted files of one strongly connected
+/// component of a crate's import graph, [`imports`]); the list may only shrink.
+const CYCLES: &[&str] = &[
+    "geom/src/crossparam/global/locate.rs geom/src/crossparam/global/mod.rs",
+    "geom/src/domain/flip.rs geom/src/domain/mod.rs geom/src/domain/tracer.rs geom/src/domain/walks.rs",
+    "geom/src/io/gltf_read.rs geom/src/io/mod.rs geom/src/io/obj.rs geom/src/io/off.rs geom/src/io/ply.rs geom/src/io/stl.rs",
+    "geom/src/mesh/build.rs geom/src/mesh/mod.rs",
+    "geom/src/metrics/surface_index.rs geom/src/metrics/surface_index/small_ball.rs",
+    "geom/src/pipeline/folds.rs geom/src/pipeline/layout_outputs.rs geom/src/pipeline/mod.rs geom/src/pipeline/parts.rs geom/src/pipeline/transfer_output.rs",
+    "geom/src/pipeline/open_loops/anchors.rs geom/src/pipeline/open_loops/mod.rs geom/src/pipeline/open_loops/pairing.rs",
+    "server/src/openapi.rs server/src/rest/artifacts.rs server/src/rest/jobs.rs server/src/rest/meshes.rs server/src/rest/mod.rs",
+];
+
+/// Every file-level import cycle of every crate.
+fn all_cycles(files: &[(String, String)]) -> Vec<String> {
+    let mut out = Vec::new();
+    for c in CRATES {
+        let src = format!("{c}/src");
+        let own: Vec<(String, String)> =
+            files.iter().filter(|(p, _)| p.starts_with(&format!("{src}/"))).cloned().collect();
+        out.extend(imports::cycles(&imports::graph(&src, &own)).into_iter().map(|c| c.join(" ")));
+    }
+    out
+}
+
+#[test]
+fn no_new_import_cycle() {
+    let found: BTreeMap<String, usize> = all_cycles(&sources()).into_iter().map(|c| (c, 1)).collect();
+    let allowed: Vec<(&str, usize)> = CYCLES.iter().map(|c| (*c, 1)).collect();
+    let errors = against("import cycle", "none: import downward", &found, &allowed);
+    assert!(errors.is_empty(), "tidy:\n{}", errors.join("\n"));
+}
+
+#[test]
+fn the_cycle_check_sees_sibling_parent_and_child_imports() {
+    let files = |a: &str, b: &str, m: &str| {
+        vec![
+            ("x/src/lib.rs".to_string(), "mod p;\n".to_string()),
+            ("x/src/p/mod.rs".to_string(), format!("mod a;\nmod b;\n{m}")),
+            ("x/src/p/a.rs".to_string(), a.to_string()),
+            ("x/src/p/b.rs".to_string(), b.to_string()),
+        ]
+    };
+    let cyc = |f: Vec<(String, String)>| imports::cycles(&imports::graph("x/src", &f));
+    // Siblings, braces expanded.
+    let f = files("use super::{b::B, c};\n", "fn g() { crate::p::a::f(); }\n", "");
+    assert_eq!(cyc(f), vec![vec!["x/src/p/a.rs".to_string(), "x/src/p/b.rs".to_string()]]);
+    // A child naming its parent's item while the parent calls the child.
+    let f = files("use super::Item;\n", "", "pub struct Item;\nfn h() { a::f(); }\n");
+    assert_eq!(cyc(f).len(), 1);
+    // Re-exports, comments and tests make no edge.
+    let f = files(
+        "use super::Item;\n// b::x\n#[cfg(test)]\nuse super::b::T;\n",
+        "use super::a::A;\n",
+        "pub use a::A;\npub struct Item;\n",
+    );
+    assert!(cyc(f).is_empty());
 }

@@ -46,7 +46,7 @@ pub struct UntangleOptions {
     pub max_attempts: usize,
     /// Runs of the global untangler ([`foldover_free`], the costliest step) from a tangle the
     /// local moves could not free, at most, over all attempts: a sweep case (7k vertices, 42
-    /// hopeless folds) spent most of its 22 s in them for nothing (bench/NOTES.md).
+    /// hopeless folds) spent most of its 22 s in them for nothing (git show 32d23d1:bench/NOTES.md).
     pub max_global: usize,
 }
 

@@ -131,7 +131,7 @@ pub fn canonical_basis_avoiding(
     let g = s.genus as usize;
     // The greedy search through every refinement first; only when it finds no basis at all,
     // the same refinements again with backtracking. Only the first bases take the second
-    // pass: it costs tens of seconds where the greedy search is stuck (bench/NOTES.md).
+    // pass: it costs tens of seconds where the greedy search is stuck (git show 32d23d1:bench/NOTES.md).
     let passes: &[usize] = if opts.basis_index < BACKTRACKED_BASES { &[0, MAX_DETOURS] } else { &[0] };
     for (pass, &detours) in passes.iter().enumerate() {
         if let Some(found) = one_pass(mesh, base, g, opts, avoid, (pass, detours))? {
@@ -312,7 +312,7 @@ fn search(
 }
 
 /// Dead ends the backtracking basis search may back out of before it gives up (each costs a
-/// cut and a search or two; genus3 through vertex 6555 needs this pass, see bench/NOTES.md).
+/// cut and a search or two; genus3 through vertex 6555 needs this pass, see git show 32d23d1:bench/NOTES.md).
 const MAX_DETOURS: usize = 30;
 
 /// Basis indices whose search may backtrack: basis 0 is the reference a job cannot do without;

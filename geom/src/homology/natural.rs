@@ -26,7 +26,7 @@ pub struct NaturalClassOptions {
     /// Bases tried on each mesh at most: while no class is stretched by at most `near`, the
     /// bases tried are doubled (2, 4, 8). Genus 2 and more has classes the first bases and the
     /// polygon's rotations do not reach (a turn inside one handle); on same-shape genus-2
-    /// cases the true class came from bases 4–5 on one mesh (bench/NOTES.md).
+    /// cases the true class came from bases 4–5 on one mesh (git show 32d23d1:bench/NOTES.md).
     pub more_bases: usize,
     /// `more_bases` from genus 3 on, where a basis through a crowded anchor can take tens of
     /// seconds to build (genus3 seed 1: 117 s with four bases; over 10 minutes with eight, measured

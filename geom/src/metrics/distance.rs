@@ -4,7 +4,7 @@
 //! through a [`SurfaceIndex`].
 
 use super::numpy_rng::NumpyRng;
-use super::surface_index::SurfaceIndex;
+use super::surface_index::{SurfaceIndex, morton_order};
 use crate::error::Result;
 use crate::mesh::{FaceId, Mesh, P3};
 
@@ -60,38 +60,6 @@ pub fn hausdorff(a: &Mesh, b: &Mesh, n: usize, seeds: (u64, u64)) -> Result<Haus
     let (ma, sa) = side(sample_surface(a, n, seeds.0), &ib);
     let (mb, sb) = side(sample_surface(b, n, seeds.1), &ia);
     Ok(HausdorffResult { hausdorff: ma.max(mb), rms: sa.max(sb).sqrt() })
-}
-
-/// Indices of `pts` sorted along a Z-order (Morton) curve of their bounding box.
-pub(crate) fn morton_order(pts: &[P3]) -> Vec<usize> {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in pts {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    let spread = |x: u64| {
-        // Interleave the low 21 bits with two zero bits each.
-        let mut x = x & 0x1f_ffff;
-        x = (x | (x << 32)) & 0x1f00000000ffff;
-        x = (x | (x << 16)) & 0x1f0000ff0000ff;
-        x = (x | (x << 8)) & 0x100f00f00f00f00f;
-        x = (x | (x << 4)) & 0x10c30c30c30c30c3;
-        (x | (x << 2)) & 0x1249249249249249
-    };
-    let q = |p: &P3, k: usize| {
-        let w = hi[k] - lo[k];
-        if w > 0.0 { (((p[k] - lo[k]) / w) * 2_097_151.0) as u64 } else { 0 }
-    };
-    let mut keyed: Vec<(u64, usize)> = pts
-        .iter()
-        .enumerate()
-        .map(|(i, p)| (spread(q(p, 0)) | (spread(q(p, 1)) << 1) | (spread(q(p, 2)) << 2), i))
-        .collect();
-    keyed.sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
 }
 
 /// numpy's pairwise summation (blocks of 128 summed with 8 accumulators), so means agree to

@@ -205,7 +205,7 @@ impl<'m> SurfaceIndex<'m> {
 
     /// The distances of [`SurfaceIndex::query`] for every point, searched in Morton order.
     pub fn distances(&self, pts: &[P3]) -> Vec<f64> {
-        self.distances_in_order(pts, &super::distance::morton_order(pts))
+        self.distances_in_order(pts, &morton_order(pts))
     }
 
     /// `f`, and when `p` (a point of `f`) lies on one of its edges or at a corner (barycentric
@@ -241,7 +241,7 @@ impl<'m> SurfaceIndex<'m> {
     /// candidates' distance order as the evaluator does), visited in Morton order.
     pub fn query_all(&self, pts: &[P3]) -> Vec<Nearest> {
         let mut out = vec![Nearest { distance: f64::INFINITY, face: FaceId(0), point: P3::origin() }; pts.len()];
-        for (i, n) in self.search_chunks(pts, &super::distance::morton_order(pts), true) {
+        for (i, n) in self.search_chunks(pts, &morton_order(pts), true) {
             out[i] = n;
         }
         out
@@ -413,6 +413,38 @@ impl<'m> SurfaceIndex<'m> {
         }
         best
     }
+}
+
+/// Indices of `pts` sorted along a Z-order (Morton) curve of their bounding box.
+pub(crate) fn morton_order(pts: &[P3]) -> Vec<usize> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in pts {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let spread = |x: u64| {
+        // Interleave the low 21 bits with two zero bits each.
+        let mut x = x & 0x1f_ffff;
+        x = (x | (x << 32)) & 0x1f00000000ffff;
+        x = (x | (x << 16)) & 0x1f0000ff0000ff;
+        x = (x | (x << 8)) & 0x100f00f00f00f00f;
+        x = (x | (x << 4)) & 0x10c30c30c30c30c3;
+        (x | (x << 2)) & 0x1249249249249249
+    };
+    let q = |p: &P3, k: usize| {
+        let w = hi[k] - lo[k];
+        if w > 0.0 { (((p[k] - lo[k]) / w) * 2_097_151.0) as u64 } else { 0 }
+    };
+    let mut keyed: Vec<(u64, usize)> = pts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (spread(q(p, 0)) | (spread(q(p, 1)) << 1) | (spread(q(p, 2)) << 2), i))
+        .collect();
+    keyed.sort_unstable();
+    keyed.into_iter().map(|(_, i)| i).collect()
 }
 
 #[cfg(test)]

@@ -10,45 +10,12 @@
 //! The choice is made once, from the meshes' summaries; the chosen method's own checks then
 //! apply as if it had been named.
 
-use super::anchor_spec::AnchorRow;
 use super::spec::{
-    FeatureSpec, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, SphericalOptions, SphericalSpec,
+    AutoSpec, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, SphericalOptions, SphericalSpec,
 };
 use crate::error::{InputError, Result};
 use crate::topology::Summary;
-use serde::{Deserialize, Serialize};
-
-/// A job whose method the service picks.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AutoSpec {
-    pub anchors: Vec<AnchorRow>,
-    /// Corresponding feature curves (they pick `homology`).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub features: Vec<FeatureSpec>,
-    #[serde(default)]
-    pub options: AutoOptions,
-}
-
-/// The options every pair method takes. Every field has a default.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct AutoOptions {
-    /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
-    pub metric_samples: usize,
-    /// Source attributes to carry onto the target (`target_transferred.glb`).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub transfer: Vec<String>,
-    /// `morph.glb` also holds the target placed on the source (the inverse pair).
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub inverse_morph: bool,
-}
-
-impl Default for AutoOptions {
-    fn default() -> Self {
-        Self { metric_samples: 100_000, transfer: Vec::new(), inverse_morph: false }
-    }
-}
+use serde::Serialize;
 
 /// Which method an `auto` job ran, and why (`metrics.json`'s `auto`).
 #[derive(Debug, Clone, PartialEq, Serialize)]

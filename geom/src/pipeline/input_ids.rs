@@ -5,8 +5,7 @@
 //! [`InputLayout::welded`]; other inputs' ids are the mesh's already.
 
 use super::anchor_spec::AnchorRow;
-use super::auto::AutoSpec;
-use super::spec::{HomologySpec, JobSpec};
+use super::spec::{AutoSpec, HomologySpec, JobSpec};
 use crate::error::{InputError, Result};
 use crate::mesh::InputLayout;
 use crate::mesh::layout::VertexIds;

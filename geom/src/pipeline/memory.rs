@@ -1,7 +1,7 @@
 //! A job's peak memory, estimated before it runs from its meshes' sizes and its options, so a
 //! service can refuse a job that would not fit its budget instead of letting it die
 //! half-way. The model is linear in what the job allocates in bulk; its constants are fitted
-//! to measured peaks (the resident set of `surfmap map` / `surfmap remesh`; `bench/NOTES.md`)
+//! to measured peaks (the resident set of `surfmap map` / `surfmap remesh`; `git show 32d23d1:bench/NOTES.md`)
 //! and rounded up, so the estimate errs high.
 
 use super::spec::JobSpec;
@@ -17,7 +17,7 @@ const PER_VERTEX: u64 = 6 << 10;
 /// genus 2 on) and the side domains the natural-class search keeps (`homology::sides`). Fitted
 /// with [`HOMOLOGY_PER_VERTEX_PER_GENUS`] to measured peaks: 3holes (genus 3, 7.2k vertices in
 /// all) 808 MiB, genus3 (13.3k) 1059 MiB, cup (genus 2, 20k) 489 MiB, kitten (genus 1, 20k)
-/// 127 MiB (`bench/NOTES.md`).
+/// 127 MiB (`git show 32d23d1:bench/NOTES.md`).
 const HOMOLOGY_PER_GENUS: u64 = 160 << 20;
 /// A `homology` job's extra bytes per input vertex and handle (refined copies of each mesh in
 /// the bases and domains kept).
@@ -107,7 +107,7 @@ mod tests {
     }
 
     /// The homology estimate stays above the peaks measured on the shared meshes (resident
-    /// set of `surfmap map`, default job with one anchor; bench/NOTES.md).
+    /// set of `surfmap map`, default job with one anchor; git show 32d23d1:bench/NOTES.md).
     #[test]
     fn homology_estimates_cover_the_measured_peaks() {
         let job = JobSpec::from_json(br#"{"method": "homology", "anchors": [[0, 0]]}"#).expect("a homology job");

@@ -21,7 +21,6 @@ mod layout_outputs;
 mod limits;
 mod memory;
 pub mod open_loops;
-mod open_map;
 mod optimize;
 pub mod parts;
 pub mod quad;
@@ -33,14 +32,14 @@ mod transfer_output;
 pub mod voronoi;
 
 pub use anchor_spec::{AnchorPoints, AnchorRow, FacePoint, PointRef};
-pub use auto::{AutoChoice, AutoOptions, AutoSpec};
+pub use auto::AutoChoice;
 pub use common::{Artifact, PairReport};
 pub use limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_FEATURES, MAX_METRIC_SAMPLES, MAX_MODELS, MAX_MORPH_FRAMES};
-pub use quad::{QuadReport, Remeshes, remesh_all_for_bench};
+pub use quad::{QuadReport, Remeshes};
 pub use quad_spec::{Interpolation, LevelSchedule, MorphDomain, MorphOptions, QuadOptions, QuadSpec};
 pub use spec::{
-    FeatureSpec, GlobalOptions, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, METHODS, MapOptions, Method,
-    RelaxOptions, SphericalOptions, SphericalSpec,
+    AutoOptions, AutoSpec, FeatureSpec, GlobalOptions, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, METHODS,
+    MapOptions, Method, RelaxOptions, SphericalOptions, SphericalSpec,
 };
 pub use transfer_output::attribute_names;
 

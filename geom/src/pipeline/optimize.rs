@@ -12,7 +12,7 @@
 //! It runs only where the composed maps are far from isometric (normalized energy above
 //! [`GATE`], seen: plane → bird 2.8 / 3.0), not on same-shape pairs or SMPL man → woman
 //! (1.7–2.0), where the relaxation alone does as well and the optimized maps lost the contest
-//! after seconds of work (figures in `bench/NOTES.md`).
+//! after seconds of work (figures in `git show 32d23d1:bench/NOTES.md`).
 
 use super::global_choice::{GlobalInputs, RELAXED_AREA_SLACK, domain_lengths};
 use crate::crossparam::global::domain_map::{DomainMapReport, DomainOptimizer};

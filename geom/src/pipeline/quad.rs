@@ -407,12 +407,3 @@ fn morph_artifacts(spec: &QuadSpec, rm: &Remeshes) -> Result<Vec<Artifact>> {
     }
     Ok(arts)
 }
-
-/// Uniform remeshes of a genus-0 consistent parameterization (for benchmarks).
-///
-/// # Errors
-/// As [`remesh_all`].
-pub fn remesh_all_for_bench(cp: &ConsistentResult, level: u32) -> Result<Remeshes> {
-    let b = build_genus0(cp)?;
-    remesh_all(&b, level, None, &[])
-}

@@ -133,7 +133,7 @@ pub fn router(state: AppState) -> Router {
         .route("/v1/jobs/{id}/events", get(jobs::job_events))
         .route("/v1/jobs/{id}/artifacts", get(artifacts::list_artifacts))
         .route("/v1/jobs/{id}/artifacts/{name}", get(artifacts::get_artifact))
-        .route("/openapi.json", get(ops::openapi))
+        .route("/openapi.json", get(crate::openapi::serve))
         .route("/healthz", get(ops::healthz))
         .route("/readyz", get(ops::readyz))
         .route("/metrics", get(ops::metrics))

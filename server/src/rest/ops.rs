@@ -1,4 +1,5 @@
-//! Operations routes: liveness, readiness, Prometheus metrics and the OpenAPI document.
+//! Operations routes: liveness, readiness and Prometheus metrics (the OpenAPI document's
+//! route is `crate::openapi::serve`).
 
 use crate::AppState;
 use crate::error::ApiError;
@@ -38,10 +39,4 @@ pub async fn metrics(
         }
     }
     Ok(([(header::CONTENT_TYPE, "text/plain; version=0.0.4")], surfmap_worker::telemetry::prometheus().render()))
-}
-
-/// The OpenAPI 3.1 document of this API.
-#[utoipa::path(get, path = "/openapi.json", tag = "ops", responses((status = 200, description = "OpenAPI document")))]
-pub async fn openapi(State(st): State<AppState>) -> Json<serde_json::Value> {
-    Json(crate::openapi::document(st.auth.enabled()))
 }

@@ -286,3 +286,24 @@ fn the_cycle_check_sees_sibling_parent_and_child_imports() {
     );
     assert!(cyc(f).is_empty());
 }
+
+/// The files of each pipeline method (one job kind each); none imports another's.
+const METHOD_FILES: &[&str] = &[
+    "geom/src/pipeline/voronoi.rs",
+    "geom/src/pipeline/homology.rs",
+    "geom/src/pipeline/features.rs",
+    "geom/src/pipeline/quad.rs",
+    "geom/src/pipeline/spherical.rs",
+];
+
+#[test]
+fn no_pipeline_method_imports_another() {
+    let files: Vec<(String, String)> = sources().into_iter().filter(|(p, _)| p.starts_with("geom/src/")).collect();
+    let g = imports::graph("geom/src", &files);
+    let mut errors = Vec::new();
+    for m in METHOD_FILES {
+        let to = g.get(*m).unwrap_or_else(|| panic!("{m} is not a geom source file"));
+        errors.extend(to.iter().filter(|t| METHOD_FILES.contains(&t.as_str())).map(|t| format!("{m} imports {t}")));
+    }
+    assert!(errors.is_empty(), "a pipeline method imports another:\n{}", errors.join("\n"));
+}

@@ -1,9 +1,10 @@
 //! Injective optimization of maps: the building blocks of a global distortion minimization
 //! that keeps a map bijective at every step (issue 35). [`sym_dirichlet`] is the per-triangle
-//! energy with its projected Hessian, [`max_step`] the flip-avoiding step bound,
+//! energy with its projected Hessian ([`isotropic`]: in closed form), [`max_step`] the flip-avoiding step bound,
 //! [`block_system`] the fixed-pattern sparse Newton system, and [`newton`] the optimizer.
 
 pub mod block_system;
+pub mod isotropic;
 pub mod max_step;
 pub mod newton;
 pub mod sym_dirichlet;

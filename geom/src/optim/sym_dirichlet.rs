@@ -12,8 +12,9 @@
 //! for a step) measures `L J` instead of `J`; and each corner's unknowns may live in a chart of
 //! their own, carried into the triangle's chart by a linear map `M_i` (a rigid transition).
 
+use super::isotropic::{Profile, projected};
 use crate::param::Uv;
-use nalgebra::{Matrix4, SMatrix, SymmetricEigen, Vector4};
+use nalgebra::{Matrix4, SMatrix, Vector4};
 
 /// A triangle's rest shape: the inverse of its rest edge matrix and its rest area.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -144,7 +145,7 @@ impl RestTriangle {
         let v = self.jacobian_in(x, l);
         let (g, h) = jacobian_derivatives_eps(&v, eps)?;
         let e = self.energy_eps(x, l, eps)?;
-        Some(self.carried_to_corners(e, g, project_psd(h), l, m))
+        Some(self.carried_to_corners(e, g, h, l, m))
     }
 
     /// Energy, gradient and PSD-projected Hessian at `x`; `None` when inverted or degenerate.
@@ -158,7 +159,7 @@ impl RestTriangle {
         let v = self.jacobian_in(x, l);
         let (g, h) = jacobian_derivatives(&v)?;
         let e = self.energy_in(x, l)?;
-        Some(self.carried_to_corners(e, g, project_psd(h), l, m))
+        Some(self.carried_to_corners(e, g, h, l, m))
     }
 
     /// Energy and derivatives in `vec(L J)` carried to the corners' displacements.
@@ -178,33 +179,18 @@ impl RestTriangle {
     }
 }
 
-/// Gradient and Hessian of `f(J) = |J|² (1 + 1/det(J)²)` in `vec(J) = (a, b, c, d)`.
+/// Gradient and projected Hessian of `f(J) = |J|² (1 + 1/det(J)²)` in `vec(J) = (a, b, c, d)`.
 fn jacobian_derivatives(v: &Vector4<f64>) -> Option<(Vector4<f64>, Matrix4<f64>)> {
-    let (a, b, c, d) = (v[0], v[1], v[2], v[3]);
-    let det = a * d - b * c;
+    let det = v[0] * v[3] - v[1] * v[2];
     if det.is_nan() || det <= 0.0 {
         return None;
     }
-    let s = v.norm_squared();
-    let (i2, i3, i4) = (det.powi(-2), det.powi(-3), det.powi(-4));
-    let g = 1.0 + i2;
-    let dd = Vector4::new(d, -c, -b, a);
-    let grad = v * (2.0 * g) - dd * (2.0 * s * i3);
-    // ∂²det: 1 at (a, d), −1 at (b, c).
-    let mut k = Matrix4::zeros();
-    k[(0, 3)] = 1.0;
-    k[(3, 0)] = 1.0;
-    k[(1, 2)] = -1.0;
-    k[(2, 1)] = -1.0;
-    let hess = Matrix4::identity() * (2.0 * g) - (v * dd.transpose() + dd * v.transpose()) * (4.0 * i3)
-        + (dd * dd.transpose() * (6.0 * i4) - k * (2.0 * i3)) * s;
-    (grad.iter().chain(hess.iter()).all(|x| x.is_finite())).then_some((grad, hess))
+    projected(v, Profile { h: 1.0 + det.powi(-2), h1: -2.0 * det.powi(-3), h2: 6.0 * det.powi(-4) })
 }
 
-/// Gradient and Hessian of `|J|² (1 + 1/χ(det J, ε)²)` in `vec(J)`.
+/// Gradient and projected Hessian of `|J|² (1 + 1/χ(det J, ε)²)` in `vec(J)`.
 fn jacobian_derivatives_eps(v: &Vector4<f64>, eps: f64) -> Option<(Vector4<f64>, Matrix4<f64>)> {
-    let (a, b, c, d) = (v[0], v[1], v[2], v[3]);
-    let det = a * d - b * c;
+    let det = v[0] * v[3] - v[1] * v[2];
     let r = (eps * eps + det * det).sqrt();
     if r <= 0.0 {
         return None;
@@ -212,36 +198,20 @@ fn jacobian_derivatives_eps(v: &Vector4<f64>, eps: f64) -> Option<(Vector4<f64>,
     let chi = 0.5 * (det + r);
     let (c1, c2) = (0.5 * (1.0 + det / r), 0.5 * eps * eps / (r * r * r));
     // h(D) = 1 + χ⁻², and its first two derivatives in D.
-    let h = 1.0 + chi.powi(-2);
-    let h1 = -2.0 * chi.powi(-3) * c1;
-    let h2 = 6.0 * chi.powi(-4) * c1 * c1 - 2.0 * chi.powi(-3) * c2;
-    let s = v.norm_squared();
-    let dd = Vector4::new(d, -c, -b, a);
-    let grad = v * (2.0 * h) + dd * (s * h1);
-    let mut k = Matrix4::zeros();
-    k[(0, 3)] = 1.0;
-    k[(3, 0)] = 1.0;
-    k[(1, 2)] = -1.0;
-    k[(2, 1)] = -1.0;
-    let hess = Matrix4::identity() * (2.0 * h)
-        + (v * dd.transpose() + dd * v.transpose()) * (2.0 * h1)
-        + (dd * dd.transpose() * h2 + k * h1) * s;
-    (grad.iter().chain(hess.iter()).all(|x| x.is_finite())).then_some((grad, hess))
-}
-
-/// The nearest positive semi-definite matrix (eigenvalues clamped at zero).
-fn project_psd(h: Matrix4<f64>) -> Matrix4<f64> {
-    let eig = SymmetricEigen::new(h);
-    if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
-        return h;
-    }
-    let l = eig.eigenvalues.map(|x| x.max(0.0));
-    eig.eigenvectors * Matrix4::from_diagonal(&l) * eig.eigenvectors.transpose()
+    projected(
+        v,
+        Profile {
+            h: 1.0 + chi.powi(-2),
+            h1: -2.0 * chi.powi(-3) * c1,
+            h2: 6.0 * chi.powi(-4) * c1 * c1 - 2.0 * chi.powi(-3) * c2,
+        },
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::SymmetricEigen;
 
     fn rest() -> RestTriangle {
         RestTriangle::new([[0.0, 0.0], [1.0, 0.0], [0.3, 0.8]]).unwrap()

@@ -233,7 +233,6 @@ mod imports;
 const CYCLES: &[&str] = &[
     "geom/src/domain/flip.rs geom/src/domain/mod.rs geom/src/domain/tracer.rs geom/src/domain/walks.rs",
     "geom/src/pipeline/folds.rs geom/src/pipeline/layout_outputs.rs geom/src/pipeline/mod.rs geom/src/pipeline/parts.rs geom/src/pipeline/transfer_output.rs",
-    "server/src/openapi.rs server/src/rest/artifacts.rs server/src/rest/jobs.rs server/src/rest/meshes.rs server/src/rest/mod.rs",
 ];
 
 /// Every file-level import cycle of every crate.

@@ -8,7 +8,7 @@
 //! (Draco, meshopt, ...), external buffer files, node hierarchies that are not trees.
 
 use super::gltf_accessor::Buffers;
-use super::{ReadOptions, check_limits};
+use super::options::{ReadOptions, check_limits};
 use crate::error::{InputError, Result, parse_err};
 use crate::mesh::{SplitMesh, Warning};
 use base64::Engine;

@@ -13,6 +13,7 @@ mod lex;
 mod obj;
 mod obj_seams;
 mod off;
+mod options;
 mod ply;
 mod ply_binary;
 mod png16;
@@ -23,69 +24,13 @@ pub use glb_write::{
 };
 pub use obj::write_layout as write_obj_layout;
 pub use obj::write_uv_patches as write_obj_uv_patches;
+pub use options::{Format, ReadOptions};
 pub use ply::write_with_face_ints as write_ply_with_face_ints;
 pub use png16::{read_rgb16, write_rgb16};
 
 use crate::error::{InputError, Result};
-use crate::mesh::{InputLayout, Mesh, MeshLimits, RawMesh, Warning, layout};
-use serde::{Deserialize, Serialize};
+use crate::mesh::{InputLayout, Mesh, RawMesh, Warning, layout};
 use std::path::Path;
-
-/// A mesh file format.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Format {
-    Obj,
-    Off,
-    Ply,
-    Stl,
-    /// glTF 2.0: `.glb`, or `.gltf` JSON with embedded buffers.
-    Gltf,
-}
-
-impl Format {
-    /// Format from a file extension (case-insensitive), if known.
-    pub fn from_extension(path: &Path) -> Option<Format> {
-        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-        Some(match ext.as_str() {
-            "obj" => Format::Obj,
-            "off" => Format::Off,
-            "ply" => Format::Ply,
-            "stl" => Format::Stl,
-            "glb" | "gltf" => Format::Gltf,
-            _ => return None,
-        })
-    }
-    /// Lower-case name (also the usual extension).
-    pub fn name(self) -> &'static str {
-        match self {
-            Format::Obj => "obj",
-            Format::Off => "off",
-            Format::Ply => "ply",
-            Format::Stl => "stl",
-            Format::Gltf => "gltf",
-        }
-    }
-}
-
-/// Options for reading.
-#[derive(Debug, Clone, Default)]
-pub struct ReadOptions {
-    /// Size limits, checked against header counts before allocating.
-    pub limits: MeshLimits,
-    /// Format to assume when content detection is ambiguous (e.g. from the file extension).
-    pub hint: Option<Format>,
-}
-
-pub(crate) fn check_limits(opts: &ReadOptions, nv: u64, nf: u64) -> Result<()> {
-    if nv > opts.limits.max_vertices {
-        return Err(InputError::TooLarge { what: "vertices", count: nv, limit: opts.limits.max_vertices }.into());
-    }
-    if nf > opts.limits.max_faces {
-        return Err(InputError::TooLarge { what: "faces", count: nf, limit: opts.limits.max_faces }.into());
-    }
-    Ok(())
-}
 
 /// Detects the format from the bytes; the hint breaks ties (e.g. an OBJ without `v` lines).
 ///

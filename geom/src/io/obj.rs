@@ -8,7 +8,7 @@
 
 use super::lex::{Lex, parse_f64, parse_i64, show};
 use super::obj_seams::Corners;
-use super::{ReadOptions, check_limits};
+use super::options::{ReadOptions, check_limits};
 use crate::error::{InputError, Result};
 use crate::mesh::layout::VertexIds;
 use crate::mesh::{InputLayout, Mesh, RawMesh, V3, Warning};

@@ -4,7 +4,7 @@
 //! Header counts are checked against the bytes left before anything is allocated.
 
 use super::lex::{Lex, parse_f64, show};
-use super::{ReadOptions, check_limits};
+use super::options::{ReadOptions, check_limits};
 use crate::error::{InputError, Result};
 use crate::mesh::{Mesh, RawMesh, V3};
 

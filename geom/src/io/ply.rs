@@ -4,7 +4,8 @@
 //! Before the payload is parsed, the header's element counts are checked against the bytes
 //! that follow it, so a lying header fails at once without allocating.
 
-use super::{ReadOptions, check_limits, ply_binary};
+use super::options::{ReadOptions, check_limits};
+use super::ply_binary;
 use crate::error::{InputError, Result, parse_err};
 use crate::mesh::{Mesh, RawMesh, V3};
 use ply_rs_bw::parser::{Parser, Reader};

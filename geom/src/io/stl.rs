@@ -4,7 +4,7 @@
 //! triangle count that promises more than the file holds, before anything is allocated.
 //! Faces that collapse after welding are dropped with a warning.
 
-use super::{ReadOptions, check_limits};
+use super::options::{ReadOptions, check_limits};
 use crate::error::{InputError, Result, parse_err};
 use crate::mesh::{Mesh, RawMesh, Warning};
 

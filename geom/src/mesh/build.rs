@@ -65,17 +65,6 @@ impl RawMesh {
     }
 }
 
-pub(crate) fn check_finite(positions: &[P3]) -> Result<()> {
-    for (i, p) in positions.iter().enumerate() {
-        for &c in p.coords.iter() {
-            if !c.is_finite() {
-                return Err(InputError::NonFiniteCoordinate { vertex: i, value: c }.into());
-            }
-        }
-    }
-    Ok(())
-}
-
 impl Mesh {
     /// Builds a mesh from raw polygons, with the warnings of reading and repair.
     ///

@@ -128,7 +128,7 @@ impl Mesh {
             ))
             .into());
         }
-        build::check_finite(&positions)?;
+        check_finite(&positions)?;
         let mut m = self.clone();
         m.positions = positions;
         Ok(m)
@@ -282,4 +282,15 @@ impl Iterator for Outgoing<'_> {
         self.cur = self.mesh.twin(h.prev()).filter(|&n| n != self.start);
         Some(h)
     }
+}
+
+fn check_finite(positions: &[P3]) -> crate::Result<()> {
+    for (i, p) in positions.iter().enumerate() {
+        for &c in p.coords.iter() {
+            if !c.is_finite() {
+                return Err(crate::InputError::NonFiniteCoordinate { vertex: i, value: c }.into());
+            }
+        }
+    }
+    Ok(())
 }

@@ -36,10 +36,13 @@ pub struct SurfaceIndex<'m> {
     centroids: Vec<[f64; 3]>,
     /// The face-size tiers of distance-only searches ([`small_ball`]), unless too many faces
     /// are large for them to pay.
-    tiers: Option<small_ball::Tiers>,
+    tiers: Option<Tiers>,
 }
 
 mod small_ball;
+mod tiers;
+
+use tiers::Tiers;
 
 /// One query's answer.
 #[derive(Debug, Clone, Copy)]
@@ -188,7 +191,7 @@ impl<'m> SurfaceIndex<'m> {
         let tree = ImmutableKdTree::new_from_slice(&cents).map_err(|e| Error::Internal(format!("k-d tree: {e:?}")))?;
         let k = NonZeroUsize::new(CANDIDATES.min(mesh.n_faces()))
             .ok_or_else(|| Error::Internal("mesh has no faces".into()))?;
-        let tiers = small_ball::Tiers::new(&cents, &radius)?;
+        let tiers = Tiers::new(&cents, &radius)?;
         Ok(Self { mesh, tree, k, radius, centroids: cents, tiers })
     }
 

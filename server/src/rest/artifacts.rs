@@ -1,6 +1,6 @@
 //! Artifact routes: the list of a job's files and each file with its content type.
 
-use super::{Owner, P};
+use super::extract::{Owner, P};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
 use crate::views::{ArtifactList, artifact_view};

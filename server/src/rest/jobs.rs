@@ -1,6 +1,6 @@
 //! Job routes: submit (JSON or multipart), get, list, cancel, and SSE progress.
 
-use super::{Owner, P, Q, is_multipart, multipart_error, read_limited, reserve_upload};
+use super::extract::{Owner, P, Q, is_multipart, multipart_error, read_limited, reserve_upload};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
 use crate::service::{SpecInput, format_hint, job_filter};

@@ -1,6 +1,6 @@
 //! `POST /v1/meshes`: a raw body or a multipart file part.
 
-use super::{Owner, P, Q, is_multipart, multipart_error, read_limited, reserve_upload};
+use super::extract::{Owner, P, Q, is_multipart, multipart_error, read_limited, reserve_upload};
 use crate::AppState;
 use crate::error::{ApiError, ErrorBody};
 use crate::service::format_hint;

@@ -4,7 +4,7 @@
 //! vertices cross them.
 
 use super::charts::Charts;
-use super::solve::{Rows, State};
+use super::solve::{Rows, State, face_uv};
 use crate::mesh::{FaceId, Mesh};
 use crate::param::Uv;
 use crate::planar::locate::{Grid, barycentric};
@@ -84,7 +84,7 @@ fn patch_locator(
         let f = FaceId(f);
         // The face in its reference corner's chart (links keep it whole around cone points),
         // then moved into p's chart on the sheet nearest p's triangle.
-        let Some(q) = super::face_uv(mesh, st, rows, fixed, f) else { continue };
+        let Some(q) = face_uv(mesh, st, rows, fixed, f) else { continue };
         let t = mesh.face(f);
         let r = (0..3).find(|&k| !fixed[t[k].idx()]).unwrap_or(0);
         let Some(a) = charts.transition_near_patch(st.patch[t[r].idx()], p, q[r]) else { continue };

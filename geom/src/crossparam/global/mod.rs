@@ -26,7 +26,7 @@ use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::param::{Uv, stretch_jacobian};
 use charts::Charts;
 use serde::{Deserialize, Serialize};
-use solve::{Rows, State};
+use solve::{Rows, State, face_uv};
 
 /// Options for [`global_param`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -205,24 +205,6 @@ fn relax(
         st.carry_links(rows, &moved_by);
     }
     Ok(residual)
-}
-
-/// The face's three chart positions in the chart of its first corner that is not an anchor
-/// (an anchor's chart is its home patch's, which need not be near the face), through the links
-/// of that corner's row.
-pub(crate) fn face_uv(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool], f: FaceId) -> Option<[Uv; 3]> {
-    let t = mesh.face(f);
-    let r = (0..3).find(|&k| !fixed[t[k].idx()]).unwrap_or(0);
-    let i = t[r].idx();
-    let mut out = [st.uv[i]; 3];
-    for k in 0..3 {
-        if k != r {
-            let j = t[k].idx();
-            let s = solve::slot_of(rows, i, j)?;
-            out[k] = st.neighbour(s, j)?;
-        }
-    }
-    Some(out)
 }
 
 /// Area-weighted L2 stretch (uv scaled to the surface's area); a face without a chart

@@ -7,7 +7,7 @@
 
 use super::charts::{Affine, Charts};
 use crate::error::{Error, Result};
-use crate::mesh::{Mesh, VertexId};
+use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::param::Uv;
 use faer::Mat;
 use faer::Side;
@@ -239,4 +239,22 @@ impl System {
 /// The slot of `j` in `i`'s row.
 pub fn slot_of(rows: &Rows, i: usize, j: usize) -> Option<usize> {
     (rows.start[i]..rows.start[i + 1]).find(|&s| rows.nbr[s].0 as usize == j)
+}
+
+/// The face's three chart positions in the chart of its first corner that is not an anchor
+/// (an anchor's chart is its home patch's, which need not be near the face), through the links
+/// of that corner's row.
+pub(crate) fn face_uv(mesh: &Mesh, st: &State, rows: &Rows, fixed: &[bool], f: FaceId) -> Option<[Uv; 3]> {
+    let t = mesh.face(f);
+    let r = (0..3).find(|&k| !fixed[t[k].idx()]).unwrap_or(0);
+    let i = t[r].idx();
+    let mut out = [st.uv[i]; 3];
+    for k in 0..3 {
+        if k != r {
+            let j = t[k].idx();
+            let s = slot_of(rows, i, j)?;
+            out[k] = st.neighbour(s, j)?;
+        }
+    }
+    Some(out)
 }

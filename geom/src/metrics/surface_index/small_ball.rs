@@ -19,69 +19,16 @@
 //! the ball is a few faces wide instead of twice the k nearest's reach, and its radius follows
 //! the previous block's need. A point whose checks fail takes the k-nearest search.
 
+use super::tiers::Tiers;
 use super::{Nearest, SurfaceIndex};
-use crate::error::{Error, Result};
 use crate::mesh::P3;
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use kiddo::SquaredEuclidean;
 
 /// Margin of the next ball over the previous block's largest need.
 const GROWTH: f64 = 1.25;
 
 /// Relative slack on every bound (rounding of distances and of their squares).
 const SLACK: f64 = 1e-9;
-
-/// A face is large when its radius exceeds this multiple of the median.
-const LARGE: f64 = 2.0;
-
-/// Most large faces, as a fraction of all, for the tiers to pay (`1 / LARGE_SHARE`).
-const LARGE_SHARE: usize = 16;
-
-/// The two face tiers.
-pub(super) struct Tiers {
-    /// The largest radius of a small face.
-    small_max: f64,
-    /// The largest radius of any face.
-    all_max: f64,
-    /// Centroids of the large faces, and their face ids.
-    large: Option<(ImmutableKdTree<f64, 3>, Vec<u32>)>,
-}
-
-impl Tiers {
-    /// The tiers of faces with these centroids and radii, or `None` when more than one face in
-    /// [`LARGE_SHARE`] is large.
-    ///
-    /// # Errors
-    /// `Error::Internal` if the large faces' tree cannot be built.
-    pub(super) fn new(centroids: &[[f64; 3]], radius: &[f64]) -> Result<Option<Self>> {
-        if radius.is_empty() {
-            return Ok(None);
-        }
-        let mut sorted = radius.to_vec();
-        let median = *sorted.select_nth_unstable_by(radius.len() / 2, f64::total_cmp).1;
-        let cut = LARGE * median;
-        let large: Vec<u32> = (0..radius.len()).filter(|&f| radius[f] > cut).map(|f| f as u32).collect();
-        if large.len() * LARGE_SHARE > radius.len() {
-            return Ok(None);
-        }
-        let small_max = radius.iter().copied().filter(|&r| r <= cut).fold(0.0, f64::max);
-        let all_max = radius.iter().copied().fold(0.0, f64::max);
-        let large = if large.is_empty() {
-            None
-        } else {
-            let pts: Vec<[f64; 3]> = large.iter().map(|&f| centroids[f as usize]).collect();
-            let tree =
-                ImmutableKdTree::new_from_slice(&pts).map_err(|e| Error::Internal(format!("k-d tree: {e:?}")))?;
-            Some((tree, large))
-        };
-        Ok(Some(Self { small_max, all_max, large }))
-    }
-
-    /// Whether some faces are large.
-    #[cfg(test)]
-    pub(super) fn has_large(&self) -> bool {
-        self.large.is_some()
-    }
-}
 
 /// The centroids gathered for a block, as columns.
 #[derive(Default)]

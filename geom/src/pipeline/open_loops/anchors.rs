@@ -3,7 +3,7 @@
 //! gap), and every anchor of the closed meshes its number: the job's, the added ones, the apexes.
 
 use super::pairing::{Corr, check_order};
-use super::{BoundaryReport, OpenPlan, name};
+use super::plan::{BoundaryReport, OpenPlan, name};
 use crate::domain::loops::LoopAnchors;
 use crate::error::{InputError, Result};
 use crate::homology::curve_align::angle_sums;

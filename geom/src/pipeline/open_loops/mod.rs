@@ -14,57 +14,17 @@ use crate::map::SurfaceMap;
 use crate::mesh::cap::{CapLoop, Capped, cap_loops};
 use crate::mesh::{Mesh, VertexId};
 use pairing::{Corr, loop_of, pair_by_nearest_anchor};
-use serde::Serialize;
 
 mod anchors;
 mod pairing;
+mod plan;
 mod sides;
+
+use plan::name;
+pub use plan::{BoundaryReport, LoopName, OpenPlan};
 
 /// Weight below which a loop vertex's image counts as on the loop edge.
 const ON_LOOP: f64 = 1e-6;
-
-/// A boundary loop named by its first vertex and its length in vertices.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct LoopName {
-    pub first_vertex: u32,
-    pub vertices: usize,
-}
-
-/// How one pair of loops was mapped (`metrics.json`, `boundaries`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct BoundaryReport {
-    pub source_loop: LoopName,
-    pub target_loop: LoopName,
-    /// `anchors` (the job's anchors on the loop), `boundaries` (a `boundaries` row) or
-    /// `nearest_anchor` (the loop had neither).
-    pub paired_by: &'static str,
-    /// The job's anchors on the loop (indices into its anchor list).
-    pub anchors: Vec<usize>,
-    /// Loop anchors added at equal arc-length fractions between the given ones.
-    pub added: usize,
-    /// Loop vertices whose image is not on the other mesh's loop, both ways (0 when done).
-    pub off_loop: [usize; 2],
-}
-
-/// The closed meshes of a job on open meshes, with every anchor the layout needs.
-pub struct OpenPlan {
-    pub source: Capped,
-    pub target: Capped,
-    /// Anchors on the closed meshes: the job's, then the added loop anchors, then the apexes.
-    pub sa: Vec<VertexId>,
-    pub ta: Vec<VertexId>,
-    /// The job's own anchors (the first of `sa` / `ta`).
-    pub job_anchors: usize,
-    s_loops: Vec<LoopAnchors>,
-    t_loops: Vec<LoopAnchors>,
-    /// Interior angle at each vertex of the open meshes (the loops' turning, for alignment).
-    angles: [Vec<f64>; 2],
-    report: Vec<BoundaryReport>,
-}
-
-fn name(l: &CapLoop) -> LoopName {
-    LoopName { first_vertex: l.vertices[0].0, vertices: l.vertices.len() }
-}
 
 /// Equal boundary-loop counts, or `InputError::TopologyMismatch` naming each mesh's loops
 /// (first vertex and length).

@@ -2,7 +2,7 @@
 //! the anchor nearest a loop that has neither; the correspondences on a loop pair must run the
 //! same way round on both.
 
-use super::name;
+use super::plan::name;
 use crate::error::{InputError, Result};
 use crate::mesh::cap::{CapLoop, Capped};
 use crate::mesh::{Mesh, VertexId};

@@ -1,6 +1,6 @@
 //! The target's loop sides aligned with the source's for the patch maps.
 
-use super::OpenPlan;
+use super::plan::OpenPlan;
 use crate::crossparam::SideFractions;
 use crate::domain::loops::LoopAnchors;
 use crate::domain::refine::Refined;

@@ -10,52 +10,17 @@ pub mod cuts;
 pub mod flip;
 pub mod greedy;
 pub mod loops;
+mod path;
 pub mod refine;
 pub mod straighten;
 pub mod tracer;
 pub mod voronoi;
 pub mod walks;
 
-use crate::geodesic::NodeId;
-use crate::topology::SurfacePoint;
+pub(crate) use path::uf_find;
+pub use path::{LayoutPath, Sector};
+
 use serde::{Deserialize, Serialize};
-
-/// A path of a layout between anchors `a` and `b` (indices into the anchor list).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct LayoutPath {
-    pub a: u32,
-    pub b: u32,
-    pub nodes: Vec<NodeId>,
-    pub points: Vec<SurfacePoint>,
-    pub length: f64,
-}
-
-/// Root of `x` in a union-find forest (with path halving).
-pub(crate) fn uf_find(p: &mut [usize], mut x: usize) -> usize {
-    while p[x] != x {
-        p[x] = p[p[x]];
-        x = p[x];
-    }
-    x
-}
-
-/// A cyclic interval of ring keys around an anchor, both ends excluded; `from == to` means
-/// every key but that one.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Sector {
-    pub from: u32,
-    pub to: u32,
-}
-
-impl Sector {
-    pub fn contains(&self, k: u32) -> bool {
-        match self.from.cmp(&self.to) {
-            std::cmp::Ordering::Less => self.from < k && k < self.to,
-            std::cmp::Ordering::Greater => k > self.from || k < self.to,
-            std::cmp::Ordering::Equal => k != self.from,
-        }
-    }
-}
 
 /// A triangular patch: corner anchors and the halves that bound it (`sides[i]` runs from
 /// `corners[i]` to `corners[i + 1]`, with the patch on its right).

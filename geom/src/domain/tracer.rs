@@ -11,7 +11,7 @@
 //! ([`EdgeNodeGraph::ring_key`]), which gives the rotation system of the layout graph; its
 //! face walks ([`super::walks`]) are the regions of the layout.
 
-use super::{LayoutPath, Sector};
+use super::path::{LayoutPath, Sector};
 use crate::error::{Error, InputError, Result};
 use crate::geodesic::{EdgeNodeGraph, EdgeNodeOptions, NodeId, SearchFilter};
 use crate::mesh::{FaceId, Mesh, VertexId};

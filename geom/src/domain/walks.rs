@@ -6,8 +6,8 @@
 //! For a connected graph on a closed surface, `V - E + W = χ` holds exactly when every region
 //! is a disk bounded by one walk (each non-disk region adds at least one walk or a handle).
 
+use super::path::{Sector, uf_find};
 use super::tracer::{Half, Tracer};
-use super::{Sector, uf_find};
 
 /// One face walk: `halves[i]` arrives where `halves[i + 1]` leaves.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -10,9 +10,7 @@
 //! The choice is made once, from the meshes' summaries; the chosen method's own checks then
 //! apply as if it had been named.
 
-use super::spec::{
-    AutoSpec, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, SphericalOptions, SphericalSpec,
-};
+use super::spec::{AutoSpec, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, SphericalSpec};
 use crate::error::{InputError, Result};
 use crate::topology::Summary;
 use serde::Serialize;
@@ -54,12 +52,7 @@ impl AutoSpec {
         let (spec, reason) = if !self.features.is_empty() {
             (homology(), "feature curves are mapped by homology".to_string())
         } else if closed_sphere(s) && closed_sphere(t) && self.anchors.len() >= 3 {
-            let options = SphericalOptions {
-                metric_samples: o.metric_samples,
-                transfer: o.transfer.clone(),
-                inverse_morph: o.inverse_morph,
-            };
-            let spec = JobSpec::Spherical(SphericalSpec { anchors: self.anchors.clone(), options });
+            let spec = JobSpec::Spherical(SphericalSpec { anchors: self.anchors.clone(), options: o.clone() });
             (spec, "two connected closed genus-0 meshes with at least 3 anchors".to_string())
         } else if s.boundary_loops == 0 && t.boundary_loops == 0 && (s.genus >= 1 || t.genus >= 1) {
             (homology(), format!("closed meshes of genus {} and {}", s.genus, t.genus))

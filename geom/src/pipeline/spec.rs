@@ -112,25 +112,8 @@ pub struct AutoSpec {
     pub options: AutoOptions,
 }
 
-/// The options every pair method takes. Every field has a default.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct AutoOptions {
-    /// Surface samples per direction for the Hausdorff / RMS metrics (the evaluator's 100000).
-    pub metric_samples: usize,
-    /// Source attributes to carry onto the target (`target_transferred.glb`).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub transfer: Vec<String>,
-    /// `morph.glb` also holds the target placed on the source (the inverse pair).
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub inverse_morph: bool,
-}
-
-impl Default for AutoOptions {
-    fn default() -> Self {
-        Self { metric_samples: 100_000, transfer: Vec::new(), inverse_morph: false }
-    }
-}
+/// The options every pair method takes: exactly `spherical`'s, which has no others.
+pub type AutoOptions = SphericalOptions;
 
 /// A `homology` job.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

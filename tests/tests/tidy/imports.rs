@@ -89,19 +89,8 @@ fn references(code: &str) -> Vec<Vec<String>> {
         rest = &rest[(end + 1).min(rest.len())..];
     }
     inline.push_str(rest);
-    let b = inline.as_bytes();
     for start in ["crate::", "super::", "self::"] {
-        let mut from = 0;
-        while let Some(k) = inline[from..].find(start) {
-            let at = from + k;
-            from = at + start.len();
-            if at > 0 && (b[at - 1].is_ascii_alphanumeric() || b[at - 1] == b'_' || b[at - 1] == b':') {
-                continue;
-            }
-            let path: String =
-                inline[at..].chars().take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':').collect();
-            out.push(path.split("::").filter(|s| !s.is_empty()).map(str::to_string).collect());
-        }
+        out.extend(paths_from(&inline, start));
     }
     out
 }
@@ -128,33 +117,34 @@ fn child_references(code: &str) -> Vec<Vec<String>> {
         })
         .collect::<Vec<_>>()
         .join("\n");
-    let b = code.as_bytes();
     let mut out = Vec::new();
     for c in children {
         let pat = format!("{c}::");
-        let mut from = 0;
-        while let Some(k) = code[from..].find(&pat) {
-            let at = from + k;
-            from = at + pat.len();
-            if at > 0 && (b[at - 1].is_ascii_alphanumeric() || b[at - 1] == b'_' || b[at - 1] == b':') {
-                continue;
-            }
-            let path: String =
-                code[at..].chars().take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':').collect();
-            let mut p = vec!["self".to_string()];
-            p.extend(path.split("::").filter(|s| !s.is_empty()).map(str::to_string));
-            out.push(p);
-        }
+        out.extend(paths_from(&code, &pat).into_iter().map(|p| [vec!["self".to_string()], p].concat()));
         // `use x::{...}` and `use x;`
-        for l in code.lines() {
-            let t = l.trim_start();
-            if let Some(rest) =
-                t.strip_prefix("use ").filter(|r| r.starts_with(&pat) || r.starts_with(&format!("{c};")))
-            {
-                let _ = rest;
-                out.push(vec!["self".to_string(), c.to_string()]);
-            }
+        let used =
+            |t: &str| t.strip_prefix("use ").is_some_and(|r| r.starts_with(&pat) || r.starts_with(&format!("{c};")));
+        if code.lines().any(|l| used(l.trim_start())) {
+            out.push(vec!["self".to_string(), c.to_string()]);
         }
+    }
+    out
+}
+
+/// Every path in `code` that starts with `start` (not inside a longer path or name), split
+/// at `::`.
+fn paths_from(code: &str, start: &str) -> Vec<Vec<String>> {
+    let b = code.as_bytes();
+    let mut out = Vec::new();
+    let mut from = 0;
+    while let Some(k) = code[from..].find(start) {
+        let at = from + k;
+        from = at + start.len();
+        if at > 0 && (b[at - 1].is_ascii_alphanumeric() || b[at - 1] == b'_' || b[at - 1] == b':') {
+            continue;
+        }
+        let path: String = code[at..].chars().take_while(|c| c.is_alphanumeric() || *c == '_' || *c == ':').collect();
+        out.push(path.split("::").filter(|s| !s.is_empty()).map(str::to_string).collect());
     }
     out
 }

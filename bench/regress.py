@@ -16,6 +16,8 @@ import subprocess
 import sys
 import tempfile
 
+import numpy as np
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import table2  # noqa: E402
@@ -73,6 +75,8 @@ def cases(tmp, binary):
     out = []
     smpl = None
     for name, s, t, a, _gt in table2.cases(tmp, binary):
+        if name == "cow shuffled":
+            out.extend(pipeline_cases(tmp, s, t, a))
         for method in ["voronoi", "greedy"]:
             out.append((f"{name} / {method}", "map", [s, t], {"method": method, "anchors": a}))
         if "(g" in name:
@@ -86,6 +90,30 @@ def cases(tmp, binary):
     readme = [[i, i] for i in [0, 6763, 5905, 2445, 1262, 4716, 1633, 1095, 1329, 4463, 4296, 732, 3385, 4599, 5432,
                                2913, 978, 5360, 1921, 1803]]
     out.append(("README SMPL / voronoi", "map", list(smpl), {"method": "voronoi", "anchors": readme}))
+    return out
+
+
+def pipeline_cases(tmp, s, t, a):
+    """The pipeline's own paths on one cow pair: `spherical`, `auto` (no method), anchors given as
+    surface points with the inverse morph, and a pair of meshes in two parts each."""
+    out = [
+        ("cow shuffled / spherical", "map", [s, t], {"method": "spherical", "anchors": a}),
+        ("cow shuffled / auto", "map", [s, t], {"anchors": a}),
+    ]
+    (V, F), (W, G) = table2.mm.load_mesh(s), table2.mm.load_mesh(t)
+    points = [{"source": [float(x) for x in V[i] + 1e-4], "target": {"face": int(np.flatnonzero((G == j).any(1))[0]),
+                                                                      "bary": [1 / 3, 1 / 3, 1 / 3]}}
+              for i, j in a]
+    out.append(("cow shuffled / voronoi, point anchors, inverse morph", "map", [s, t],
+                {"method": "voronoi", "anchors": points, "options": {"inverse_morph": True}}))
+    two = []
+    for tag, (X, T) in [("s", (V, F)), ("t", (W, G))]:
+        path = os.path.join(tmp, f"two_parts_{tag}.off")
+        shift = X + np.array([3.0 * np.ptp(X[:, 0]), 0.0, 0.0])
+        table2.write_off(path, np.vstack([X, shift]), np.vstack([T, T + len(X)]))
+        two.append(path)
+    rows = a + [[i + len(V), j + len(W)] for i, j in a]
+    out.append(("cow shuffled, two parts / voronoi", "map", two, {"method": "voronoi", "anchors": rows}))
     return out
 
 

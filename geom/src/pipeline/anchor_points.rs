@@ -4,7 +4,7 @@
 //! else a vertex is inserted there (`mesh::insert`). Each snap's distance is reported.
 
 use super::anchor_spec::{AnchorRow, PointRef};
-use super::spec::JobSpec;
+use super::plan::MethodPlan;
 use crate::error::{InputError, Result};
 use crate::mesh::insert::insert_points;
 use crate::mesh::{FaceId, Mesh, P3};
@@ -31,23 +31,6 @@ pub struct AnchorSnap {
     pub row: usize,
     pub source: SideSnap,
     pub target: SideSnap,
-}
-
-/// A spec whose point anchors became vertex ids, on meshes with the inserted vertices.
-pub struct Resolved {
-    pub spec: JobSpec,
-    pub meshes: Vec<Mesh>,
-    pub snaps: Vec<AnchorSnap>,
-}
-
-fn rows_mut(spec: &mut JobSpec) -> Option<&mut Vec<AnchorRow>> {
-    match spec {
-        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => Some(&mut s.anchors),
-        JobSpec::Homology(s) => Some(&mut s.anchors),
-        JobSpec::Spherical(s) => Some(&mut s.anchors),
-        JobSpec::Auto(s) => Some(&mut s.anchors),
-        JobSpec::Quad(_) => None,
-    }
 }
 
 /// `(face, bary, the given point)` of a point on `mesh`.
@@ -80,13 +63,13 @@ fn locate(
     })
 }
 
-/// Resolves the point rows of a pair job; `None` when it has none.
+/// Turns the point rows of a pair job into vertex ids; returns the meshes with the inserted
+/// vertices and each row's snap, or `None` when the job has no point rows.
 ///
 /// # Errors
 /// `InputError::Anchors` for a malformed point; `InputError::Spec` for a job without two meshes.
-pub fn resolve(spec: &JobSpec, meshes: &[Mesh]) -> Result<Option<Resolved>> {
-    let mut spec = spec.clone();
-    let Some(rows) = rows_mut(&mut spec) else { return Ok(None) };
+pub fn resolve(plan: &mut MethodPlan, meshes: &[Mesh]) -> Result<Option<(Vec<Mesh>, Vec<AnchorSnap>)>> {
+    let Some(rows) = plan.anchor_rows_mut() else { return Ok(None) };
     let points: Vec<usize> = (0..rows.len()).filter(|&r| matches!(rows[r], AnchorRow::Points(_))).collect();
     if points.is_empty() {
         return Ok(None);
@@ -125,5 +108,5 @@ pub fn resolve(spec: &JobSpec, meshes: &[Mesh]) -> Result<Option<Resolved>> {
         rows[r] = AnchorRow::Ids([u64::from(a.vertex), u64::from(b.vertex)]);
         snaps.push(AnchorSnap { row: r, source: a, target: b });
     }
-    Ok(Some(Resolved { spec, meshes: out, snaps }))
+    Ok(Some((out, snaps)))
 }

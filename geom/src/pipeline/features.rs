@@ -163,7 +163,6 @@ pub fn run(
     let pair = PairReport::new("homology", pairs.len(), (source, target), (f.m1, f.m2), f.smoothing);
     let mut report = FeatureMapReport { pair: pair.with_maps(f.s2t, f.t2s), features: report_f };
     report.pair.timings_ms = clock.finish();
-    arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);
     Ok((report, arts))
 }

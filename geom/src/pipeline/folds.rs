@@ -6,8 +6,9 @@
 //! its meta-mesh pair, which is fold-free by construction, succeeds with the folded direction's
 //! vertex-map artifacts withheld (listed in the report's `withheld`).
 
-use super::common::{Artifact, on_surface, rewrite_metrics};
-use super::{JobReport, JobSpec};
+use super::common::{Artifact, on_surface};
+use super::plan::{MethodPlan, Plan};
+use super::report::JobReport;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, VertexId};
 
@@ -22,12 +23,8 @@ const VERTEX_MAPS: [[&str; 2]; 2] =
 ///
 /// # Errors
 /// `MapFolds` when a direction folds and no fold-free meta-mesh stands in for it.
-pub(super) fn refuse_folds(
-    spec: &JobSpec,
-    meshes: &[Mesh],
-    report: &mut JobReport,
-    arts: &mut Vec<Artifact>,
-) -> Result<()> {
+pub(super) fn refuse_folds(plan: &Plan, report: &mut JobReport, arts: &mut Vec<Artifact>) -> Result<()> {
+    let meshes = &*plan.meshes;
     if let JobReport::Quad(q) = report {
         let bad: Vec<String> = q
             .per_model
@@ -66,10 +63,10 @@ pub(super) fn refuse_folds(
                 pair.withheld.extend(names.iter().map(|n| n.to_string()));
             }
         }
-        return rewrite_metrics(arts, report);
+        return Ok(());
     }
     let [s, t] = meshes else { return Ok(()) };
-    let anchors = spec_anchors(spec);
+    let anchors = plan.method.anchor_ids();
     let where_ = [(&pair.source_to_target, s, 0, "source"), (&pair.target_to_source, t, 1, "target")]
         .iter()
         .filter(|(m, ..)| m.flipped_faces > 0)
@@ -86,7 +83,7 @@ pub(super) fn refuse_folds(
         })
         .collect::<Vec<_>>()
         .join("; ");
-    Err(Error::MapFolds { flipped: counts[0] + counts[1], detail: format!("{where_}. {}", remedies(spec)) })
+    Err(Error::MapFolds { flipped: counts[0] + counts[1], detail: format!("{where_}. {}", remedies(&plan.method)) })
 }
 
 /// Largest distance of an image from the surface, as the evaluator reads it, relative to the
@@ -112,16 +109,6 @@ fn refuse_off_surface(pair: &super::common::PairReport, meshes: &[Mesh]) -> Resu
     )))
 }
 
-fn spec_anchors(spec: &JobSpec) -> Vec<[u64; 2]> {
-    match spec {
-        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
-        JobSpec::Homology(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
-        JobSpec::Spherical(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
-        JobSpec::Auto(s) => super::anchor_spec::id_rows(&s.anchors).unwrap_or_default(),
-        JobSpec::Quad(_) => Vec::new(),
-    }
-}
-
 /// "`name` face f at vertex v, nearest anchor #i (vertex w)".
 fn locate(mesh: &Mesh, f: usize, anchors: &[[u64; 2]], side: usize, name: &str) -> String {
     let Some(&v) = mesh.faces().get(f).map(|tri| &tri[0]) else { return format!("{name} face {f}") };
@@ -140,15 +127,15 @@ fn locate(mesh: &Mesh, f: usize, anchors: &[[u64; 2]], side: usize, name: &str) 
     }
 }
 
-fn remedies(spec: &JobSpec) -> &'static str {
-    match spec {
-        JobSpec::Voronoi(_) | JobSpec::Greedy(_) => {
+fn remedies(plan: &MethodPlan) -> &'static str {
+    match plan {
+        MethodPlan::Layout(..) => {
             "Add anchors near these faces, or check that the anchors keep the same order around each other on both meshes (anchors that cross on one mesh and not the other fold any map)"
         }
-        JobSpec::Spherical(_) => {
+        MethodPlan::Spherical(_) => {
             "Add anchors near these faces (they sit where a thin part of one surface meets a thick part of the other), or try method voronoi"
         }
-        JobSpec::Homology(s) if !s.features.is_empty() => {
+        MethodPlan::Homology(s) if !s.features.is_empty() => {
             "Set options.meta_mesh: true (its overlay is fold-free by construction), add anchors near these faces, or check the feature curves' order on both meshes"
         }
         _ => {
@@ -159,7 +146,8 @@ fn remedies(spec: &JobSpec) -> &'static str {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{HomologyOptions, HomologySpec, LayoutSpec, MapOptions, run_job};
+    use super::super::report::MethodOutput;
+    use super::super::{HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, run};
     use super::*;
     use crate::mesh::shapes;
     use crate::progress::NoProgress;
@@ -182,19 +170,20 @@ mod tests {
             options: MapOptions { metric_samples: 1000, ..Default::default() },
         });
         let meshes = [s, t];
-        let (mut report, mut arts) = run_job(&spec, &meshes, &mut NoProgress).unwrap();
-        assert!(refuse_folds(&spec, &meshes, &mut report, &mut arts).is_ok());
+        let plan = Plan::new(&spec, &meshes, &[]).unwrap();
+        let MethodOutput { mut report, artifacts: mut arts } = run::run(&plan, &mut NoProgress).unwrap();
+        assert!(refuse_folds(&plan, &mut report, &mut arts).is_ok());
         let JobReport::Layout(r) = &mut report else { panic!("a layout report") };
         // Fold-free with an image off the surface: a typed failure too.
         r.pair.source_to_target.off_surface_max = 0.01;
-        let e = refuse_folds(&spec, &meshes, &mut report, &mut arts).unwrap_err();
+        let e = refuse_folds(&plan, &mut report, &mut arts).unwrap_err();
         assert_eq!(e.code(), "numerical");
         assert!(e.to_string().contains("off the surface (source -> target: 1.000e-2)"), "{e}");
         let JobReport::Layout(r) = &mut report else { panic!("a layout report") };
         r.pair.source_to_target.off_surface_max = 0.0;
         r.pair.target_to_source.flipped_faces = 2;
         r.pair.target_to_source.flipped_face_ids = vec![7, 11];
-        let e = refuse_folds(&spec, &meshes, &mut report, &mut arts).unwrap_err();
+        let e = refuse_folds(&plan, &mut report, &mut arts).unwrap_err();
         assert_eq!(e.code(), "map_folds");
         let m = e.to_string();
         assert!(m.contains("(2 flipped faces)") && m.contains("target -> source: 2"), "{m}");
@@ -215,17 +204,17 @@ mod tests {
             options,
         });
         let meshes = [s, t];
-        let (mut report, mut arts) = run_job(&spec, &meshes, &mut NoProgress).unwrap();
+        let plan = Plan::new(&spec, &meshes, &[]).unwrap();
+        let MethodOutput { mut report, artifacts: mut arts } = run::run(&plan, &mut NoProgress).unwrap();
         let JobReport::Homology(r) = &mut report else { panic!("a homology report") };
         assert!(r.homology.meta_mesh.as_ref().is_some_and(|m| m.error.is_none()), "meta-mesh built");
         r.pair.source_to_target.flipped_faces = 1;
         r.pair.source_to_target.flipped_face_ids = vec![3];
-        refuse_folds(&spec, &meshes, &mut report, &mut arts).unwrap();
+        refuse_folds(&plan, &mut report, &mut arts).unwrap();
         let names: Vec<&str> = arts.iter().map(|a| a.name.as_str()).collect();
         assert!(!names.contains(&"source_on_target.obj") && !names.contains(&"source_to_target.csv"), "{names:?}");
         assert!(names.contains(&"target_on_source.obj") && names.contains(&"meta_source.obj"), "{names:?}");
-        let metrics: serde_json::Value =
-            serde_json::from_slice(&arts.iter().find(|a| a.name == "metrics.json").unwrap().bytes).unwrap();
-        assert_eq!(metrics["withheld"], serde_json::json!(["source_on_target.obj", "source_to_target.csv"]));
+        let withheld = &report.pair().unwrap().withheld;
+        assert_eq!(withheld, &["source_on_target.obj", "source_to_target.csv"]);
     }
 }

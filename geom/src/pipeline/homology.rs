@@ -173,7 +173,6 @@ pub fn run(
     };
     let mut report = HomologyMapReport { pair: pair.with_maps(f.s2t, f.t2s), homology: report_h };
     report.pair.timings_ms = clock.finish();
-    arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);
     Ok((report, arts))
 }

@@ -5,11 +5,11 @@
 //! [`InputLayout::welded`]; other inputs' ids are the mesh's already.
 
 use super::anchor_spec::AnchorRow;
-use super::spec::{AutoSpec, HomologySpec, JobSpec};
+use super::plan::MethodPlan;
+use super::spec::HomologySpec;
 use crate::error::{InputError, Result};
 use crate::mesh::InputLayout;
 use crate::mesh::layout::VertexIds;
-use std::borrow::Cow;
 
 fn map_id(id: &mut u64, table: Option<&[u32]>, mesh: usize) -> Result<()> {
     if let Some(t) = table {
@@ -36,20 +36,20 @@ fn id_rows<'t>(rows: &mut [AnchorRow], table: &dyn Fn(usize) -> Option<&'t [u32]
     Ok(())
 }
 
-/// The spec with every vertex id in welded numbering (borrowed when nothing changes).
+/// Turns every vertex id of the plan into welded numbering (nothing changes for inputs
+/// without a layout of their own).
 ///
 /// # Errors
 /// `InputError::Anchors` for an id past the input's vertices.
-pub fn to_welded<'a>(spec: &'a JobSpec, layouts: &[Option<&InputLayout>]) -> Result<Cow<'a, JobSpec>> {
+pub fn to_welded(plan: &mut MethodPlan, layouts: &[Option<&InputLayout>]) -> Result<()> {
     let tables: Vec<Option<&[u32]>> =
         layouts.iter().map(|l| l.filter(|l| l.ids == VertexIds::Input).map(|l| l.welded.as_slice())).collect();
     if tables.iter().all(Option::is_none) {
-        return Ok(Cow::Borrowed(spec));
+        return Ok(());
     }
     let table = |k: usize| tables.get(k).copied().flatten();
-    let mut s = spec.clone();
-    match &mut s {
-        JobSpec::Voronoi(l) | JobSpec::Greedy(l) => {
+    match plan {
+        MethodPlan::Layout(_, l) => {
             id_rows(&mut l.anchors, &table)?;
             for row in &mut l.boundaries {
                 for (k, id) in row.iter_mut().enumerate() {
@@ -57,9 +57,8 @@ pub fn to_welded<'a>(spec: &'a JobSpec, layouts: &[Option<&InputLayout>]) -> Res
                 }
             }
         }
-        JobSpec::Spherical(x) => id_rows(&mut x.anchors, &table)?,
-        JobSpec::Homology(HomologySpec { anchors, features, .. })
-        | JobSpec::Auto(AutoSpec { anchors, features, .. }) => {
+        MethodPlan::Spherical(x) => id_rows(&mut x.anchors, &table)?,
+        MethodPlan::Homology(HomologySpec { anchors, features, .. }) => {
             id_rows(anchors, &table)?;
             for f in features {
                 for id in &mut f.source {
@@ -70,7 +69,7 @@ pub fn to_welded<'a>(spec: &'a JobSpec, layouts: &[Option<&InputLayout>]) -> Res
                 }
             }
         }
-        JobSpec::Quad(q) => {
+        MethodPlan::Quad(q) => {
             let rows = q.anchors.iter_mut().chain(q.options.feature_anchors.iter_mut());
             for row in rows {
                 for (k, id) in row.iter_mut().enumerate() {
@@ -79,5 +78,5 @@ pub fn to_welded<'a>(spec: &'a JobSpec, layouts: &[Option<&InputLayout>]) -> Res
             }
         }
     }
-    Ok(Cow::Owned(s))
+    Ok(())
 }

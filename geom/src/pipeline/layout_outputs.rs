@@ -2,8 +2,8 @@
 //! attributes and seam copies and one morph target that places it on the target; the
 //! re-embedded OBJs with the inputs' `vt` / `vn`.
 
-use super::JobReport;
 use super::common::Artifact;
+use super::report::JobReport;
 use crate::io;
 use crate::mesh::{InputLayout, Mesh, P3, VertexId};
 

@@ -1,10 +1,10 @@
 //! One job, one call: a typed [`JobSpec`] and its meshes in, a report and named artifacts out.
 //! Nothing here touches files or sockets; callers write the artifacts wherever they keep them.
 //!
-//! [`run_job`] dispatches once, on the spec's method, to one pipeline per method
-//! ([`voronoi`] for `voronoi` and `greedy`, [`homology`], [`features`] for `homology` with
-//! feature curves or boundaries, [`quad`], [`spherical`]). Each imports [`common`] and the spec, never another
-//! method's file.
+//! [`run_job`] runs three phases, each a type: the spec and meshes become a [`Plan`]
+//! ([`plan`]), the plan runs one pipeline per method into a [`MethodOutput`] ([`run`]), and
+//! [`finish`] turns that into the job's report and artifacts. Each method imports [`common`] and
+//! the spec, never another method's file.
 
 mod anchor_points;
 mod anchor_spec;
@@ -12,6 +12,7 @@ mod auto;
 mod check;
 pub mod common;
 pub mod features;
+mod finish;
 mod folds;
 mod global_choice;
 pub mod homology;
@@ -22,10 +23,13 @@ mod limits;
 mod memory;
 pub mod open_loops;
 mod optimize;
-pub mod parts;
+mod parts;
+pub mod plan;
 pub mod quad;
 mod quad_spec;
 mod ranges;
+mod report;
+pub mod run;
 mod spec;
 pub mod spherical;
 mod transfer_output;
@@ -35,65 +39,19 @@ pub use anchor_spec::{AnchorPoints, AnchorRow, FacePoint, PointRef};
 pub use auto::AutoChoice;
 pub use common::{Artifact, PairReport};
 pub use limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_FEATURES, MAX_METRIC_SAMPLES, MAX_MODELS, MAX_MORPH_FRAMES};
+pub use plan::{MethodPlan, OutputOptions, Plan};
 pub use quad::{QuadReport, Remeshes};
 pub use quad_spec::{Interpolation, LevelSchedule, MorphDomain, MorphOptions, QuadOptions, QuadSpec};
+pub use report::{JobReport, MethodOutput, PartsReport};
 pub use spec::{
     AutoOptions, AutoSpec, FeatureSpec, GlobalOptions, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, METHODS,
     MapOptions, Method, RelaxOptions, SphericalOptions, SphericalSpec,
 };
 pub use transfer_output::attribute_names;
 
-use crate::error::{InputError, Result};
+use crate::error::Result;
 use crate::mesh::{InputLayout, Mesh};
 use crate::progress::Progress;
-use serde::Serialize;
-
-/// A finished job's report (`metrics.json`), one type per pipeline.
-#[derive(Debug, Clone, Serialize)]
-#[serde(untagged)]
-pub enum JobReport {
-    Layout(voronoi::LayoutMapReport),
-    Homology(homology::HomologyMapReport),
-    Features(features::FeatureMapReport),
-    Quad(QuadReport),
-    Spherical(spherical::SphericalMapReport),
-    /// A pair job on meshes in several parts.
-    Parts(Box<parts::PartsReport>),
-}
-
-impl JobReport {
-    /// Both directions' metrics of a pair job.
-    pub fn pair(&self) -> Option<&PairReport> {
-        match self {
-            JobReport::Layout(r) => Some(&r.pair),
-            JobReport::Homology(r) => Some(&r.pair),
-            JobReport::Features(r) => Some(&r.pair),
-            JobReport::Parts(r) => Some(&r.pair),
-            JobReport::Spherical(r) => Some(&r.pair),
-            JobReport::Quad(_) => None,
-        }
-    }
-
-    /// [`JobReport::pair`], mutably.
-    pub fn pair_mut(&mut self) -> Option<&mut PairReport> {
-        match self {
-            JobReport::Layout(r) => Some(&mut r.pair),
-            JobReport::Homology(r) => Some(&mut r.pair),
-            JobReport::Features(r) => Some(&mut r.pair),
-            JobReport::Parts(r) => Some(&mut r.pair),
-            JobReport::Spherical(r) => Some(&mut r.pair),
-            JobReport::Quad(_) => None,
-        }
-    }
-
-    /// Milliseconds per stage.
-    pub fn timings_ms(&self) -> &[(String, f64)] {
-        match self {
-            JobReport::Quad(r) => &r.timings_ms,
-            _ => self.pair().map_or(&[], |p| &p.timings_ms),
-        }
-    }
-}
 
 /// Runs any job on its meshes (two for pair jobs, in source, target order).
 ///
@@ -107,7 +65,8 @@ pub fn run_job(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> 
 
 /// [`run_job`] on inputs read with their own layouts (glTF, OBJ with seams): vertex ids of
 /// the spec count each input's own vertices, and `morph.glb` is the source in its layout with
-/// its attributes. `layouts` may be shorter than `meshes` (missing = none).
+/// its attributes. `layouts` may be shorter than `meshes` (missing = none). The job's three
+/// phases: [`Plan::new`], [`run::run`], [`finish::finish`].
 ///
 /// # Errors
 /// As [`run_job`]; `InputError::Anchors` for an id past an input's vertices.
@@ -117,98 +76,9 @@ pub fn run_with_layouts(
     layouts: &[Option<InputLayout>],
     progress: &mut dyn Progress,
 ) -> Result<(JobReport, Vec<Artifact>)> {
-    let layouts: Vec<Option<&InputLayout>> = layouts.iter().map(Option::as_ref).collect();
-    let (chosen, auto) = match spec {
-        JobSpec::Auto(a) => {
-            let summaries: Vec<_> = meshes.iter().map(crate::topology::summary).collect();
-            let (spec, why) = a.resolve(&summaries)?;
-            (Some(spec), Some(why))
-        }
-        _ => (None, None),
-    };
-    let spec = chosen.as_ref().unwrap_or(spec);
-    let spec = &*input_ids::to_welded(spec, &layouts)?;
-    let originals = meshes;
-    let transfer = match spec {
-        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => transfer_output::parse(&s.options.transfer)?,
-        JobSpec::Homology(s) => transfer_output::parse(&s.options.transfer)?,
-        JobSpec::Spherical(s) => transfer_output::parse(&s.options.transfer)?,
-        JobSpec::Auto(s) => transfer_output::parse(&s.options.transfer)?,
-        JobSpec::Quad(_) => Default::default(),
-    };
-    let wants_transfer = !transfer.texcoords.is_empty() || transfer.color || transfer.skin;
-    if let (true, Some(source)) = (wants_transfer, meshes.first()) {
-        transfer_output::check_source(&transfer, source, layouts.first().copied().flatten())?;
-    }
-    let resolved = anchor_points::resolve(spec, meshes)?;
-    let (spec, meshes) = match &resolved {
-        Some(r) => (&r.spec, r.meshes.as_slice()),
-        None => (spec, meshes),
-    };
-    let (mut report, mut arts) = match parts::run(spec, meshes, progress)? {
-        Some(whole) => whole,
-        None => dispatch(spec, meshes, progress)?,
-    };
-    if let (Some(r), Some(pair)) = (&resolved, report.pair_mut()) {
-        pair.anchor_points = r.snaps.clone();
-        common::rewrite_metrics(&mut arts, &report)?;
-    }
-    if let (Some(why), Some(pair)) = (auto, report.pair_mut()) {
-        pair.auto = Some(why);
-        common::rewrite_metrics(&mut arts, &report)?;
-    }
-    folds::refuse_folds(spec, meshes, &mut report, &mut arts)?;
-    let inverse = match spec {
-        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => s.options.inverse_morph,
-        JobSpec::Homology(s) => s.options.inverse_morph,
-        JobSpec::Spherical(s) => s.options.inverse_morph,
-        JobSpec::Auto(s) => s.options.inverse_morph,
-        JobSpec::Quad(_) => false,
-    };
-    layout_outputs::add_morph(&report, (originals, meshes), &layouts, inverse, &mut arts);
-    layout_outputs::rewrite_objs(&report, originals, meshes, &layouts, &mut arts);
-    if wants_transfer {
-        transfer_output::add(&report, &transfer, (originals, meshes), &layouts, &mut arts)?;
-    }
-    Ok((report, arts))
-}
-/// One pipeline per method.
-fn dispatch(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Result<(JobReport, Vec<Artifact>)> {
-    let pair = || match meshes {
-        [s, t] => Ok((s, t)),
-        _ => Err(InputError::Spec(format!(
-            "method {} maps a source onto a target: 2 meshes, got {}",
-            spec.method().name(),
-            meshes.len()
-        ))),
-    };
-    Ok(match spec {
-        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => {
-            let (a, b) = pair()?;
-            let (r, arts) = voronoi::run(spec.method(), s, a, b, progress)?;
-            (JobReport::Layout(r), arts)
-        }
-        JobSpec::Homology(s) => {
-            let (a, b) = pair()?;
-            if features::applies(s, a) {
-                let (r, arts) = features::run(s, a, b, progress)?;
-                (JobReport::Features(r), arts)
-            } else {
-                let (r, arts) = homology::run(s, a, b, progress)?;
-                (JobReport::Homology(r), arts)
-            }
-        }
-        JobSpec::Quad(s) => {
-            let (r, arts) = quad::run(s, meshes, progress)?;
-            (JobReport::Quad(r), arts)
-        }
-        JobSpec::Spherical(s) => {
-            let (a, b) = pair()?;
-            let (r, arts) = spherical::run(s, a, b, progress)?;
-            (JobReport::Spherical(r), arts)
-        }
-        JobSpec::Auto(_) => return Err(crate::Error::Internal("an auto job reached dispatch unresolved".into())),
-    })
+    let plan = Plan::new(spec, meshes, layouts)?;
+    let output = run::run(&plan, progress)?;
+    finish::finish(&plan, output)
 }
 
 #[cfg(test)]
@@ -255,7 +125,9 @@ mod cancel_tests {
             options: MapOptions::default(),
         });
         let mut p = CancelAt { stage: Stage::Smooth, token: CancelToken::default(), seen: Vec::new() };
-        let r = run_job(&spec, &[s, t], &mut p);
+        let meshes = [s, t];
+        let plan = Plan::new(&spec, &meshes, &[]).unwrap();
+        let r = run::run(&plan, &mut p);
         assert!(matches!(r, Err(Error::Cancelled)), "{:?}", r.err());
         assert!(p.seen.contains(&Stage::Smooth), "{:?}", p.seen);
         assert!(

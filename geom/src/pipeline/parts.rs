@@ -1,30 +1,17 @@
-//! Meshes in several parts (eyes, teeth beside a head): the parts pair up through the anchors,
-//! each pair is mapped by the job's method on its own, and the maps are joined into one map of
-//! the whole meshes, measured as a whole. A part with no anchor, or anchors that pair one part
-//! with two, is a typed error naming the part.
+//! Meshes in several parts (eyes, teeth beside a head): the parts pair up through the anchors
+//! ([`plan`], in the plan phase), each pair is mapped by the job's method on its own, and the
+//! maps are joined into one map of the whole meshes, measured as a whole ([`join`]). A part with
+//! no anchor, or anchors that pair one part with two, is a typed error naming the part.
 
-use super::anchor_spec::{AnchorRow, id_rows};
 use super::common::artifacts::maps_and_meshes as artifacts_of_maps;
-use super::common::{Artifact, PairReport, json_artifact};
-use super::spec::JobSpec;
-use super::{JobReport, run_job};
+use super::common::{Artifact, PairReport};
+use super::report::{JobReport, MethodOutput, PartsReport};
+use super::spec::Method;
 use crate::error::{InputError, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::metrics::{MetricsOptions, evaluate_map};
-use crate::progress::Progress;
 use crate::topology::{self, components};
-use serde::Serialize;
-
-/// The whole pair's metrics and each part pair's own report.
-#[derive(Debug, Clone, Serialize)]
-pub struct PartsReport {
-    #[serde(flatten)]
-    pub pair: PairReport,
-    /// `[source part, target part]` per mapped pair, in source part order.
-    pub part_pairs: Vec<[usize; 2]>,
-    pub parts: Vec<JobReport>,
-}
 
 /// One connected component as a mesh of its own.
 struct Part {
@@ -33,6 +20,28 @@ struct Part {
     vertices: Vec<u32>,
     /// Local face -> whole face.
     faces: Vec<u32>,
+}
+
+/// A source part and its partner, with the job's anchors and boundary rows among them in the
+/// parts' own numbering.
+pub struct PartPair {
+    /// The source part's mesh, then the target part's.
+    pub meshes: [Mesh; 2],
+    /// Local vertex -> whole vertex, per side.
+    vertices: [Vec<u32>; 2],
+    /// Local face -> whole face, per side.
+    faces: [Vec<u32>; 2],
+    pub anchors: Vec<[u64; 2]>,
+    pub boundaries: Vec<[u64; 2]>,
+}
+
+/// The part pairs of a job on meshes in several parts, in source part order.
+pub struct PartsPlan {
+    pub pairs: Vec<PartPair>,
+    /// `[source part, target part]` per pair.
+    part_pairs: Vec<[usize; 2]>,
+    /// The whole job's anchors.
+    rows: Vec<[u64; 2]>,
 }
 
 fn split(m: &Mesh) -> Result<(Vec<Part>, Vec<u32>)> {
@@ -66,16 +75,18 @@ fn describe(side: &str, k: usize, p: &Part) -> String {
     format!("{side} part {k} ({} vertices, genus {}, first vertex {})", s.vertices, s.genus, p.vertices[0])
 }
 
-/// Runs a pair job part by part when either mesh has several parts; `None` otherwise.
+/// Pairs the parts when either mesh has several; `None` when both are connected (or the job
+/// is not a pair job). `rows` and `boundaries` are the job's anchor and boundary rows.
 ///
 /// # Errors
-/// `InputError::Anchors` naming a part without anchors or paired twice; the method's errors.
-pub fn run(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Result<Option<(JobReport, Vec<Artifact>)>> {
-    let ([s, t], Some(rows)) = (meshes, anchor_rows(spec)) else { return Ok(None) };
+/// `InputError::Anchors` naming a part without anchors or paired twice, or an anchor out of
+/// range; `TopologyMismatch` for unequal part counts.
+pub fn plan(meshes: &[Mesh], rows: &[[u64; 2]], boundaries: &[[u64; 2]]) -> Result<Option<PartsPlan>> {
+    let [s, t] = meshes else { return Ok(None) };
     if topology::components(s).count == 1 && topology::components(t).count == 1 {
         return Ok(None);
     }
-    let rows = id_rows(rows)?;
+    let rows = rows.to_vec();
     if let Some((i, r)) =
         rows.iter().enumerate().find(|(_, r)| r[0] >= s.n_vertices() as u64 || r[1] >= t.n_vertices() as u64)
     {
@@ -117,25 +128,24 @@ pub fn run(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Resu
         ))
         .into());
     }
-    let mut parts = Vec::with_capacity(sp.len());
-    let mut arts = Vec::new();
-    let (mut s2t, mut t2s) = (
-        SurfaceMap { face: vec![FaceId(0); s.n_vertices()], bary: vec![[0.0; 3]; s.n_vertices()] },
-        SurfaceMap { face: vec![FaceId(0); t.n_vertices()], bary: vec![[0.0; 3]; t.n_vertices()] },
-    );
+    let (mut sp, mut tp): (Vec<Option<Part>>, Vec<Option<Part>>) =
+        (sp.into_iter().map(Some).collect(), tp.into_iter().map(Some).collect());
+    let mut pairs = Vec::with_capacity(sp.len());
     for (a, &b) in partner.iter().enumerate() {
-        let (ps, pt) = (&sp[a], &tp[b]);
+        let (Some(ps), Some(pt)) = (sp[a].take(), tp[b].take()) else {
+            return Err(crate::Error::Internal("a part paired twice".into()));
+        };
         let (mut ls, mut lt) = (vec![u64::MAX; s.n_vertices()], vec![u64::MAX; t.n_vertices()]);
         ps.vertices.iter().enumerate().for_each(|(i, &v)| ls[v as usize] = i as u64);
         pt.vertices.iter().enumerate().for_each(|(i, &v)| lt[v as usize] = i as u64);
-        let local: Vec<[u64; 2]> = rows
+        let anchors: Vec<[u64; 2]> = rows
             .iter()
             .filter(|r| sl[r[0] as usize] as usize == a)
             .map(|r| [ls[r[0] as usize], lt[r[1] as usize]])
             .collect();
         // `boundaries` rows (open parts) in the part's own numbering.
         let mut bounds = Vec::new();
-        for (i, r) in boundary_rows(spec).iter().enumerate() {
+        for (i, r) in boundaries.iter().enumerate() {
             let (Some(&ps_l), Some(&pt_l)) = (sl.get(r[0] as usize), lt.get(r[1] as usize)) else { continue };
             if ps_l as usize != a {
                 continue;
@@ -148,79 +158,63 @@ pub fn run(spec: &JobSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Resu
             }
             bounds.push([ls[r[0] as usize], pt_l]);
         }
-        let sub = with_anchors(spec, AnchorRow::ids(local), bounds);
-        let (rep, part_arts) = run_job(&sub, &[ps.mesh.clone(), pt.mesh.clone()], progress)?;
+        pairs.push(PartPair {
+            meshes: [ps.mesh, pt.mesh],
+            vertices: [ps.vertices, pt.vertices],
+            faces: [ps.faces, pt.faces],
+            anchors,
+            boundaries: bounds,
+        });
+    }
+    let part_pairs = partner.iter().enumerate().map(|(a, &b)| [a, b]).collect();
+    Ok(Some(PartsPlan { pairs, part_pairs, rows }))
+}
+
+/// Joins each part pair's maps into the whole meshes' maps, measured as a whole; each part's
+/// artifacts come with a `partK_` prefix.
+///
+/// # Errors
+/// `Internal` when a part's report has no maps; the metrics' errors.
+pub fn join(
+    plan: &PartsPlan,
+    meshes: &[Mesh],
+    method: Method,
+    samples: usize,
+    outputs: Vec<MethodOutput>,
+) -> Result<MethodOutput> {
+    let [s, t] = meshes else { return Err(crate::Error::Internal("a parts job without two meshes".into())) };
+    let mut parts = Vec::with_capacity(outputs.len());
+    let mut arts = Vec::new();
+    let (mut s2t, mut t2s) = (
+        SurfaceMap { face: vec![FaceId(0); s.n_vertices()], bary: vec![[0.0; 3]; s.n_vertices()] },
+        SurfaceMap { face: vec![FaceId(0); t.n_vertices()], bary: vec![[0.0; 3]; t.n_vertices()] },
+    );
+    for (a, (pair, out)) in plan.pairs.iter().zip(outputs).enumerate() {
+        let rep = out.report;
         let maps =
             rep.pair().and_then(|p| p.maps.clone()).ok_or_else(|| crate::Error::Internal("a part's maps".into()))?;
-        for (i, &v) in ps.vertices.iter().enumerate() {
-            s2t.face[v as usize] = FaceId(pt.faces[maps.s2t.face[i].idx()]);
+        let ([sv, tv], [sf, tf]) = (&pair.vertices, &pair.faces);
+        for (i, &v) in sv.iter().enumerate() {
+            s2t.face[v as usize] = FaceId(tf[maps.s2t.face[i].idx()]);
             s2t.bary[v as usize] = maps.s2t.bary[i];
         }
-        for (i, &v) in pt.vertices.iter().enumerate() {
-            t2s.face[v as usize] = FaceId(ps.faces[maps.t2s.face[i].idx()]);
+        for (i, &v) in tv.iter().enumerate() {
+            t2s.face[v as usize] = FaceId(sf[maps.t2s.face[i].idx()]);
             t2s.bary[v as usize] = maps.t2s.bary[i];
         }
-        arts.extend(part_arts.into_iter().map(|x| Artifact { name: format!("part{a}_{}", x.name), ..x }));
+        arts.extend(out.artifacts.into_iter().map(|x| Artifact { name: format!("part{a}_{}", x.name), ..x }));
         parts.push(rep);
     }
-    let samples = match spec {
-        JobSpec::Voronoi(x) | JobSpec::Greedy(x) => x.options.metric_samples,
-        JobSpec::Homology(x) => x.options.metric_samples,
-        JobSpec::Spherical(x) => x.options.metric_samples,
-        JobSpec::Auto(x) => x.options.metric_samples,
-        JobSpec::Quad(_) => 100_000,
-    };
     let mo = MetricsOptions { samples, ..Default::default() };
     let (on_target, on_source) = (s2t.embed(s, t)?, t2s.embed(t, s)?);
     let anchors: Vec<(VertexId, VertexId)> =
-        rows.iter().map(|r| (VertexId(r[0] as u32), VertexId(r[1] as u32))).collect();
+        plan.rows.iter().map(|r| (VertexId(r[0] as u32), VertexId(r[1] as u32))).collect();
     let back_anchors: Vec<(VertexId, VertexId)> = anchors.iter().map(|&(a, b)| (b, a)).collect();
     let m1 = evaluate_map(s, t, &on_target, Some(&anchors), None, &mo)?;
     let m2 = evaluate_map(t, s, &on_source, Some(&back_anchors), None, &mo)?;
     arts.extend(artifacts_of_maps(&s2t, &t2s, &on_target, &on_source));
     let pair =
-        PairReport::new(spec.method().name(), rows.len(), (s, t), (m1, m2), Default::default()).with_maps(s2t, t2s);
-    let part_pairs = partner.iter().enumerate().map(|(a, &b)| [a, b]).collect();
-    let report = JobReport::Parts(Box::new(PartsReport { pair, part_pairs, parts }));
-    arts.push(json_artifact("metrics.json", &report)?);
-    Ok(Some((report, arts)))
-}
-
-fn anchor_rows(spec: &JobSpec) -> Option<&[AnchorRow]> {
-    match spec {
-        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => Some(&s.anchors),
-        JobSpec::Homology(s) if s.features.is_empty() => Some(&s.anchors),
-        _ => None,
-    }
-}
-
-fn boundary_rows(spec: &JobSpec) -> &[[u64; 2]] {
-    match spec {
-        JobSpec::Voronoi(s) | JobSpec::Greedy(s) => &s.boundaries,
-        _ => &[],
-    }
-}
-
-fn with_anchors(spec: &JobSpec, anchors: Vec<AnchorRow>, boundaries: Vec<[u64; 2]>) -> JobSpec {
-    let mut s = spec.clone();
-    match &mut s {
-        JobSpec::Voronoi(x) | JobSpec::Greedy(x) => {
-            (x.anchors, x.boundaries, x.options.transfer) = (anchors, boundaries, Vec::new());
-            x.options.inverse_morph = false;
-        }
-        JobSpec::Homology(x) => {
-            (x.anchors, x.options.transfer) = (anchors, Vec::new());
-            x.options.inverse_morph = false;
-        }
-        JobSpec::Spherical(x) => {
-            (x.anchors, x.options.transfer) = (anchors, Vec::new());
-            x.options.inverse_morph = false;
-        }
-        JobSpec::Auto(x) => {
-            (x.anchors, x.options.transfer) = (anchors, Vec::new());
-            x.options.inverse_morph = false;
-        }
-        JobSpec::Quad(_) => {}
-    }
-    s
+        PairReport::new(method.name(), plan.rows.len(), (s, t), (m1, m2), Default::default()).with_maps(s2t, t2s);
+    let report = JobReport::Parts(Box::new(PartsReport { pair, part_pairs: plan.part_pairs.clone(), parts }));
+    Ok(MethodOutput { report, artifacts: arts })
 }

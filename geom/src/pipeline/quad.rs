@@ -2,7 +2,7 @@
 //! uniform or adaptive remesh -> geometry images and normal maps -> morphs -> metrics, with
 //! progress, cancellation and per-stage timings.
 
-use super::common::{Artifact, Clock, json_artifact};
+use super::common::{Artifact, Clock};
 use super::quad_spec::{MorphDomain, QuadSpec};
 use crate::error::{Error, Result};
 use crate::io::{self, Format};
@@ -252,7 +252,6 @@ pub fn run(spec: &QuadSpec, meshes: &[Mesh], progress: &mut dyn Progress) -> Res
         per_model,
         timings_ms: clock.finish(),
     };
-    arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);
     Ok((report, arts))
 }

@@ -3,7 +3,7 @@
 //! repairs another's output: a direction whose images stay turned over fails the job as
 //! folded ([`super::folds`]).
 
-use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
+use super::common::{Artifact, Clock, PairReport, artifacts, both};
 use super::spec::SphericalSpec;
 use crate::error::Result;
 use crate::map::SurfaceMap;
@@ -75,7 +75,7 @@ pub fn run(
     )?;
     let (m1, m2) = (m1?, m2?);
     clock.lap("metrics");
-    let mut arts = artifacts::maps_and_meshes(&s2t, &t2s, &on_target, &on_source);
+    let arts = artifacts::maps_and_meshes(&s2t, &t2s, &on_target, &on_source);
     let spherical = SphericalReport {
         source_embedding: es.report,
         target_embedding: et.report,
@@ -86,7 +86,6 @@ pub fn run(
     let mut report = SphericalMapReport { pair: pair.with_maps(s2t, t2s), spherical };
     clock.lap("artifacts");
     report.pair.timings_ms = clock.finish();
-    arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);
     Ok((report, arts))
 }

@@ -1,8 +1,8 @@
 //! `options.transfer`: `target_transferred.glb`, the target in its own layout with the named
 //! attributes of the source carried through the target -> source map (`map::transfer`).
 
-use super::JobReport;
 use super::common::Artifact;
+use super::report::JobReport;
 use crate::error::{InputError, Result};
 use crate::io;
 use crate::map::transfer::{SourceField, TransferOptions, transfer};

@@ -4,9 +4,7 @@
 
 use super::common::inverse::InversePair;
 use super::common::relax::{Direction, finish_direction, measure_direction, relax_chords, relax_local};
-use super::common::{
-    Artifact, Clock, PairReport, VISIBLE, artifacts, both, json_artifact, on_surface, rewrite_metrics,
-};
+use super::common::{Artifact, Clock, PairReport, VISIBLE, artifacts, both, on_surface};
 use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
 use super::open_loops::{BoundaryReport, OpenPlan};
 use super::optimize::{self, OptimizeReport, Quality};
@@ -330,7 +328,6 @@ pub fn run(
         {
             second.0.pair.method = method.name();
             second.0.layout.fallback = Some(other.name().to_string());
-            rewrite_metrics(&mut second.1, &second.0)?;
             Ok(second)
         }
         Err(Error::Cancelled) => Err(Error::Cancelled),
@@ -436,11 +433,10 @@ pub(super) fn outputs(
     mut clock: Clock,
     progress: &mut dyn Progress,
 ) -> Result<(LayoutMapReport, Vec<Artifact>)> {
-    let mut arts = artifacts::map_artifacts(st, tt, patches, rs, rt, (&s2t, &t2s), on_target, on_source)?;
+    let arts = artifacts::map_artifacts(st, tt, patches, rs, rt, (&s2t, &t2s), on_target, on_source)?;
     clock.lap("artifacts");
     report.pair = report.pair.with_maps(s2t, t2s);
     report.pair.timings_ms = clock.finish();
-    arts.push(json_artifact("metrics.json", &report)?);
     progress.report(Stage::Done, 1.0);
     Ok((report, arts))
 }

@@ -137,17 +137,6 @@ impl PairReport {
     }
 }
 
-/// Replaces `metrics.json` in `arts` by `report` serialized again (after a later stage changed it).
-///
-/// # Errors
-/// As [`json_artifact`].
-pub fn rewrite_metrics(arts: &mut Vec<Artifact>, report: &impl Serialize) -> Result<()> {
-    let metrics = json_artifact("metrics.json", report)?;
-    arts.retain(|a| a.name != "metrics.json");
-    arts.push(metrics);
-    Ok(())
-}
-
 /// Distance from the surface, relative to the bounding-box diagonal, within which an image is
 /// exact to rounding as the evaluator reads it (a visible image).
 pub const VISIBLE: f64 = 1e-9;

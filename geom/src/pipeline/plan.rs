@@ -1,0 +1,183 @@
+//! Phase one of a job: a typed [`JobSpec`] and its meshes become a [`Plan`], everything a
+//! method needs and nothing it must look up again. The one resolver: `auto` picks its method,
+//! vertex ids of inputs with their own layouts become welded ids ([`input_ids`]), anchors given
+//! as points become vertices ([`anchor_points`]), meshes in several parts pair up ([`parts`]),
+//! and the options every pair method shares become one [`OutputOptions`]. A plan is only read
+//! after this; nothing turns it back into a spec.
+
+use super::anchor_points::{self, AnchorSnap};
+use super::anchor_spec::{AnchorRow, id_rows};
+use super::auto::AutoChoice;
+use super::parts::{self, PartsPlan};
+use super::quad_spec::QuadSpec;
+use super::spec::{HomologySpec, JobSpec, LayoutSpec, Method, SphericalSpec};
+use super::{input_ids, transfer_output};
+use crate::error::{Error, Result};
+use crate::map::transfer::TransferOptions;
+use crate::mesh::{InputLayout, Mesh};
+use std::borrow::Cow;
+
+/// The method to run and its own spec: a [`JobSpec`] with `auto` resolved, whose vertex ids
+/// are the welded meshes' and whose anchors are all vertex ids.
+#[derive(Debug, Clone)]
+pub enum MethodPlan {
+    /// `voronoi` or `greedy`.
+    Layout(Method, LayoutSpec),
+    Homology(HomologySpec),
+    Quad(QuadSpec),
+    Spherical(SphericalSpec),
+}
+
+impl MethodPlan {
+    fn new(spec: JobSpec) -> Result<MethodPlan> {
+        Ok(match spec {
+            JobSpec::Voronoi(s) => MethodPlan::Layout(Method::Voronoi, s),
+            JobSpec::Greedy(s) => MethodPlan::Layout(Method::Greedy, s),
+            JobSpec::Homology(s) => MethodPlan::Homology(s),
+            JobSpec::Quad(s) => MethodPlan::Quad(s),
+            JobSpec::Spherical(s) => MethodPlan::Spherical(s),
+            JobSpec::Auto(_) => return Err(Error::Internal("an auto job reached its plan unresolved".into())),
+        })
+    }
+
+    pub fn method(&self) -> Method {
+        match self {
+            MethodPlan::Layout(m, _) => *m,
+            MethodPlan::Homology(_) => Method::Homology,
+            MethodPlan::Quad(_) => Method::Quad,
+            MethodPlan::Spherical(_) => Method::Spherical,
+        }
+    }
+
+    /// A pair method's anchor rows (`quad` has none).
+    pub fn anchor_rows(&self) -> Option<&[AnchorRow]> {
+        match self {
+            MethodPlan::Layout(_, s) => Some(&s.anchors),
+            MethodPlan::Homology(s) => Some(&s.anchors),
+            MethodPlan::Spherical(s) => Some(&s.anchors),
+            MethodPlan::Quad(_) => None,
+        }
+    }
+
+    pub(super) fn anchor_rows_mut(&mut self) -> Option<&mut Vec<AnchorRow>> {
+        match self {
+            MethodPlan::Layout(_, s) => Some(&mut s.anchors),
+            MethodPlan::Homology(s) => Some(&mut s.anchors),
+            MethodPlan::Spherical(s) => Some(&mut s.anchors),
+            MethodPlan::Quad(_) => None,
+        }
+    }
+
+    /// The anchor and boundary rows of a method that maps meshes in several parts part by part
+    /// (`voronoi`, `greedy`, `homology` without feature curves).
+    fn parts_rows(&self) -> Option<(&[AnchorRow], &[[u64; 2]])> {
+        match self {
+            MethodPlan::Layout(_, s) => Some((&s.anchors, &s.boundaries)),
+            MethodPlan::Homology(s) if s.features.is_empty() => Some((&s.anchors, &[])),
+            _ => None,
+        }
+    }
+
+    /// The plan of one part pair: these anchors and boundary rows, the job's options.
+    pub fn for_part(&self, anchors: &[[u64; 2]], boundaries: &[[u64; 2]]) -> MethodPlan {
+        let mut p = self.clone();
+        if let MethodPlan::Layout(_, s) = &mut p {
+            s.boundaries = boundaries.to_vec();
+        }
+        if let Some(rows) = p.anchor_rows_mut() {
+            *rows = AnchorRow::ids(anchors.iter().copied());
+        }
+        p
+    }
+
+    /// The anchors as `[source, target]` vertex ids (empty for `quad`).
+    pub fn anchor_ids(&self) -> Vec<[u64; 2]> {
+        self.anchor_rows().and_then(|r| id_rows(r).ok()).unwrap_or_default()
+    }
+}
+
+/// The options every pair method shares, read once from whichever method's options hold them.
+#[derive(Debug, Clone)]
+pub struct OutputOptions {
+    /// Surface samples per direction for the Hausdorff / RMS metrics.
+    pub metric_samples: usize,
+    /// Source attributes carried onto the target (`target_transferred.glb`).
+    pub transfer: TransferOptions,
+    /// `morph.glb` also holds the target placed on the source.
+    pub inverse_morph: bool,
+}
+
+impl OutputOptions {
+    fn of(spec: &JobSpec) -> Result<OutputOptions> {
+        let (metric_samples, transfer, inverse_morph) = match spec {
+            JobSpec::Voronoi(s) | JobSpec::Greedy(s) => {
+                (s.options.metric_samples, &s.options.transfer, s.options.inverse_morph)
+            }
+            JobSpec::Homology(s) => (s.options.metric_samples, &s.options.transfer, s.options.inverse_morph),
+            JobSpec::Spherical(s) => (s.options.metric_samples, &s.options.transfer, s.options.inverse_morph),
+            JobSpec::Auto(s) => (s.options.metric_samples, &s.options.transfer, s.options.inverse_morph),
+            JobSpec::Quad(s) => (s.options.metric_samples, &Vec::new(), false),
+        };
+        Ok(OutputOptions { metric_samples, transfer: transfer_output::parse(transfer)?, inverse_morph })
+    }
+
+    /// Whether any attribute is carried.
+    pub fn wants_transfer(&self) -> bool {
+        !self.transfer.texcoords.is_empty() || self.transfer.color || self.transfer.skin
+    }
+}
+
+/// Everything a job runs on.
+pub struct Plan<'a> {
+    /// The meshes as read (the outputs in the inputs' own layouts refer to these).
+    pub originals: &'a [Mesh],
+    /// Each input's own layout (glTF, OBJ with seams), if it has one.
+    pub layouts: Vec<Option<&'a InputLayout>>,
+    /// The meshes the method runs on: the originals with a vertex inserted at each point anchor
+    /// that fell inside a face (after the original vertices).
+    pub meshes: Cow<'a, [Mesh]>,
+    pub method: MethodPlan,
+    pub output: OutputOptions,
+    /// For a job that named no method: what ran, and why.
+    pub auto: Option<AutoChoice>,
+    /// Anchor rows given as points, as resolved.
+    pub snaps: Vec<AnchorSnap>,
+    /// Meshes in several parts: the part pairs, each with its own method plan.
+    pub parts: Option<PartsPlan>,
+}
+
+impl<'a> Plan<'a> {
+    /// Resolves `spec` on `meshes` (two for pair jobs, source then target); `layouts` may be
+    /// shorter than `meshes` (missing = none).
+    ///
+    /// # Errors
+    /// `auto`'s choice failing; `InputError::Anchors` for an id past an input's vertices, a bad
+    /// point, a part without anchors; `InputError::Spec` for an unknown attribute to transfer;
+    /// `InputError::Invalid` for one the source lacks.
+    pub fn new(spec: &JobSpec, meshes: &'a [Mesh], layouts: &'a [Option<InputLayout>]) -> Result<Plan<'a>> {
+        let layouts: Vec<Option<&InputLayout>> = layouts.iter().map(Option::as_ref).collect();
+        let (spec, auto) = match spec {
+            JobSpec::Auto(a) => {
+                let summaries: Vec<_> = meshes.iter().map(crate::topology::summary).collect();
+                let (spec, why) = a.resolve(&summaries)?;
+                (spec, Some(why))
+            }
+            _ => (spec.clone(), None),
+        };
+        let output = OutputOptions::of(&spec)?;
+        let mut method = MethodPlan::new(spec)?;
+        input_ids::to_welded(&mut method, &layouts)?;
+        if let (true, Some(source)) = (output.wants_transfer(), meshes.first()) {
+            transfer_output::check_source(&output.transfer, source, layouts.first().copied().flatten())?;
+        }
+        let (meshes_run, snaps) = match anchor_points::resolve(&mut method, meshes)? {
+            Some((inserted, snaps)) => (Cow::Owned(inserted), snaps),
+            None => (Cow::Borrowed(meshes), Vec::new()),
+        };
+        let parts = match method.parts_rows() {
+            Some((rows, boundaries)) => parts::plan(&meshes_run, &id_rows(rows)?, boundaries)?,
+            None => None,
+        };
+        Ok(Plan { originals: meshes, layouts, meshes: meshes_run, method, output, auto, snaps, parts })
+    }
+}

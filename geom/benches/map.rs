@@ -5,7 +5,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use geom::io::{ReadOptions, read_path};
-use geom::pipeline::voronoi::run as run_map;
+use geom::pipeline::layout::run as run_map;
 use geom::pipeline::{LayoutSpec, MapOptions, Method};
 use geom::progress::NoProgress;
 

@@ -6,8 +6,8 @@
 //! classes (other H1 matrices) and still carry every feature onto its partner.
 
 use geom::mesh::{Mesh, VertexId};
-use geom::pipeline::features::run as run_map;
-use geom::pipeline::{FeatureSpec, HomologyOptions, HomologySpec, features::FeatureMapReport};
+use geom::pipeline::homology::features::run as run_map;
+use geom::pipeline::{FeatureSpec, HomologyOptions, HomologySpec, homology::features::FeatureMapReport};
 use geom::progress::NoProgress;
 
 mod common;

@@ -6,7 +6,7 @@ use geom::io::ReadOptions;
 mod common;
 use common::{fps, load, shuffled, twisted};
 use geom::mesh::{Mesh, VertexId};
-use geom::pipeline::voronoi::run as run_layout;
+use geom::pipeline::layout::run as run_layout;
 use geom::pipeline::{LayoutSpec, MapOptions, Method};
 use geom::progress::NoProgress;
 use geom::topology::Locator;

@@ -26,7 +26,7 @@ fn spec(method: &str, anchors: &[u64]) -> JobSpec {
     if method == "greedy" { JobSpec::Greedy(l) } else { JobSpec::Voronoi(l) }
 }
 
-fn layout_report(r: &JobReport) -> &geom::pipeline::voronoi::LayoutMapReport {
+fn layout_report(r: &JobReport) -> &geom::pipeline::layout::LayoutMapReport {
     match r {
         JobReport::Layout(l) => l,
         other => panic!("not a layout report: {other:?}"),
@@ -78,7 +78,7 @@ fn two_holes_pair_through_their_anchors() {
 #[test]
 fn loop_counts_that_differ_name_the_loops() {
     let (s, t) = (holed(&[0]), holed(&[0, 3]));
-    let e = geom::pipeline::voronoi::run(
+    let e = geom::pipeline::layout::run(
         geom::pipeline::Method::Voronoi,
         match &spec("voronoi", &[20, 61, 100, 150]) {
             JobSpec::Voronoi(l) => l,

@@ -278,23 +278,41 @@ fn the_cycle_check_sees_sibling_parent_and_child_imports() {
     assert!(cyc(f).is_empty());
 }
 
-/// The files of each pipeline method (one job kind each); none imports another's.
-const METHOD_FILES: &[&str] = &[
-    "geom/src/pipeline/voronoi.rs",
-    "geom/src/pipeline/homology.rs",
-    "geom/src/pipeline/features.rs",
-    "geom/src/pipeline/quad.rs",
-    "geom/src/pipeline/spherical.rs",
+/// The folder of each pipeline method (one job kind each, `homology` with its feature jobs).
+const METHOD_DIRS: &[&str] = &[
+    "geom/src/pipeline/layout/",
+    "geom/src/pipeline/homology/",
+    "geom/src/pipeline/quad/",
+    "geom/src/pipeline/spherical/",
 ];
 
+/// What a method folder may import of `pipeline` besides its own files.
+const METHOD_MAY_IMPORT: &[&str] = &["geom/src/pipeline/common/", "geom/src/pipeline/spec/"];
+
+/// The three phases in order; each imports only earlier ones (and the methods, `common`,
+/// `spec` and `report.rs`), never a later one.
+const PHASES: &[&str] = &["geom/src/pipeline/plan/", "geom/src/pipeline/run/", "geom/src/pipeline/finish/"];
+
 #[test]
-fn no_pipeline_method_imports_another() {
+fn pipeline_methods_and_phases_import_downward() {
     let files: Vec<(String, String)> = sources().into_iter().filter(|(p, _)| p.starts_with("geom/src/")).collect();
     let g = imports::graph("geom/src", &files);
     let mut errors = Vec::new();
-    for m in METHOD_FILES {
-        let to = g.get(*m).unwrap_or_else(|| panic!("{m} is not a geom source file"));
-        errors.extend(to.iter().filter(|t| METHOD_FILES.contains(&t.as_str())).map(|t| format!("{m} imports {t}")));
+    for (from, to) in g.iter().flat_map(|(f, ts)| ts.iter().map(move |t| (f, t))) {
+        if let Some(m) = METHOD_DIRS.iter().find(|d| from.starts_with(**d)) {
+            let ok = to.starts_with(*m)
+                || !to.starts_with("geom/src/pipeline/")
+                || METHOD_MAY_IMPORT.iter().any(|d| to.starts_with(*d));
+            if !ok {
+                errors.push(format!("method file {from} imports {to}"));
+            }
+        }
+        let phase = |p: &str| PHASES.iter().position(|d| p.starts_with(*d));
+        if let (Some(a), Some(b)) = (phase(from), phase(to)) {
+            if b > a {
+                errors.push(format!("phase file {from} imports the later phase's {to}"));
+            }
+        }
     }
-    assert!(errors.is_empty(), "a pipeline method imports another:\n{}", errors.join("\n"));
+    assert!(errors.is_empty(), "the pipeline imports upward:\n{}", errors.join("\n"));
 }

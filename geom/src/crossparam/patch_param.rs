@@ -63,7 +63,7 @@ impl PatchParam {
 /// Where given vertices of a refined mesh lie along their layout path, instead of by arc
 /// length: per refined vertex, the anchor its fraction counts from and the fraction (0 at that
 /// anchor, 1 at the path's other end). Open meshes' loop sides on the target use it
-/// ([`crate::pipeline::open_loops`]): aligned with the source's, not by arc length.
+/// ([`crate::pipeline::layout::open_loops`]): aligned with the source's, not by arc length.
 pub type SideFractions = Vec<Option<(u32, f64)>>;
 
 /// Flattens every patch of `r` (the faces labelled with it) onto [`TRIANGLE`].

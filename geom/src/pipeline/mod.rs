@@ -6,48 +6,30 @@
 //! [`finish`] turns that into the job's report and artifacts. Each method imports [`common`] and
 //! the spec, never another method's file.
 
-mod anchor_points;
-mod anchor_spec;
-mod auto;
-mod check;
 pub mod common;
-pub mod features;
 mod finish;
-mod folds;
-mod global_choice;
 pub mod homology;
-pub mod homology_class;
-mod input_ids;
-mod layout_outputs;
-mod limits;
-mod memory;
-pub mod open_loops;
-mod optimize;
-mod parts;
+pub mod layout;
 pub mod plan;
 pub mod quad;
-mod quad_spec;
-mod ranges;
 mod report;
 pub mod run;
 mod spec;
 pub mod spherical;
-mod transfer_output;
-pub mod voronoi;
 
-pub use anchor_spec::{AnchorPoints, AnchorRow, FacePoint, PointRef};
-pub use auto::AutoChoice;
 pub use common::{Artifact, PairReport};
-pub use limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_FEATURES, MAX_METRIC_SAMPLES, MAX_MODELS, MAX_MORPH_FRAMES};
 pub use plan::{MethodPlan, OutputOptions, Plan};
 pub use quad::{QuadReport, Remeshes};
-pub use quad_spec::{Interpolation, LevelSchedule, MorphDomain, MorphOptions, QuadOptions, QuadSpec};
 pub use report::{JobReport, MethodOutput, PartsReport};
+pub use spec::anchor_spec::{AnchorPoints, AnchorRow, FacePoint, PointRef};
+pub use spec::auto::AutoChoice;
+pub use spec::limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_FEATURES, MAX_METRIC_SAMPLES, MAX_MODELS, MAX_MORPH_FRAMES};
+pub use spec::quad_spec::{Interpolation, LevelSchedule, MorphDomain, MorphOptions, QuadOptions, QuadSpec};
+pub use spec::transfer::attribute_names;
 pub use spec::{
     AutoOptions, AutoSpec, FeatureSpec, GlobalOptions, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, METHODS,
     MapOptions, Method, RelaxOptions, SphericalOptions, SphericalSpec,
 };
-pub use transfer_output::attribute_names;
 
 use crate::error::Result;
 use crate::mesh::{InputLayout, Mesh};
@@ -55,7 +37,7 @@ use crate::progress::Progress;
 
 /// Runs any job on its meshes (two for pair jobs, in source, target order).
 ///
-/// A result with flipped faces is not a success: it fails with `MapFolds` (see [`folds`]).
+/// A result with flipped faces is not a success: it fails with `MapFolds` (see [`finish`]).
 ///
 /// # Errors
 /// `InputError::Spec` for the wrong number of meshes; `MapFolds`; whatever the method reports.

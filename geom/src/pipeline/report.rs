@@ -1,15 +1,16 @@
 //! What a job's method hands to its last phase, and what a finished job reports
-//! (`metrics.json`, written once by [`super::finish`]).
+//! (`metrics.json`, written once by [`crate::pipeline::finish`]).
 
-use super::common::{Artifact, PairReport};
-use super::{features, homology, quad, spherical, voronoi};
+use super::homology::{self, features};
+use super::{layout, quad, spherical};
+use crate::pipeline::common::{Artifact, PairReport};
 use serde::Serialize;
 
 /// A finished job's report (`metrics.json`), one type per pipeline.
 #[derive(Debug, Clone, Serialize)]
 #[serde(untagged)]
 pub enum JobReport {
-    Layout(voronoi::LayoutMapReport),
+    Layout(layout::LayoutMapReport),
     Homology(homology::HomologyMapReport),
     Features(features::FeatureMapReport),
     Quad(quad::QuadReport),

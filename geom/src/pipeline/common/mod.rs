@@ -93,10 +93,10 @@ pub struct PairReport {
     /// Anchors given as surface points: the vertex each became, its distance from the given
     /// position, whether it was inserted.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub anchor_points: Vec<super::anchor_points::AnchorSnap>,
+    pub anchor_points: Vec<crate::pipeline::plan::anchor_points::AnchorSnap>,
     /// For a job that named no method (`auto`): the method that ran, and why.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub auto: Option<super::auto::AutoChoice>,
+    pub auto: Option<crate::pipeline::spec::auto::AutoChoice>,
 }
 
 /// Both vertex maps of a pair job.

@@ -6,11 +6,11 @@
 //! its meta-mesh pair, which is fold-free by construction, succeeds with the folded direction's
 //! vertex-map artifacts withheld (listed in the report's `withheld`).
 
-use super::common::{Artifact, on_surface};
-use super::plan::{MethodPlan, Plan};
-use super::report::JobReport;
 use crate::error::{Error, Result};
 use crate::mesh::{Mesh, VertexId};
+use crate::pipeline::common::{Artifact, on_surface};
+use crate::pipeline::plan::{MethodPlan, Plan};
+use crate::pipeline::report::JobReport;
 
 /// Faces named per direction in the message.
 const NAMED: usize = 3;
@@ -92,7 +92,7 @@ pub(super) fn refuse_folds(plan: &Plan, report: &mut JobReport, arts: &mut Vec<A
 const OFF_SURFACE: f64 = 1e-6;
 
 /// A fold-free pair map with an image off the surface is as wrong as a folded one: `Numerical`.
-fn refuse_off_surface(pair: &super::common::PairReport, meshes: &[Mesh]) -> Result<()> {
+fn refuse_off_surface(pair: &crate::pipeline::common::PairReport, meshes: &[Mesh]) -> Result<()> {
     let [s, t] = meshes else { return Ok(()) };
     let bad: Vec<String> =
         [(&pair.source_to_target, t, "source -> target"), (&pair.target_to_source, s, "target -> source")]
@@ -146,10 +146,10 @@ fn remedies(plan: &MethodPlan) -> &'static str {
 
 #[cfg(test)]
 mod tests {
-    use super::super::report::MethodOutput;
-    use super::super::{HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, run};
     use super::*;
     use crate::mesh::shapes;
+    use crate::pipeline::report::MethodOutput;
+    use crate::pipeline::{HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, run};
     use crate::progress::NoProgress;
 
     fn stretched(s: &Mesh) -> Mesh {

@@ -2,10 +2,10 @@
 //! attributes and seam copies and one morph target that places it on the target; the
 //! re-embedded OBJs with the inputs' `vt` / `vn`.
 
-use super::common::Artifact;
-use super::report::JobReport;
 use crate::io;
 use crate::mesh::{InputLayout, Mesh, P3, VertexId};
+use crate::pipeline::common::Artifact;
+use crate::pipeline::report::JobReport;
 
 /// Adds `morph.glb` to a pair job's artifacts (not when a folded direction was withheld):
 /// the source in its own layout with one morph target on the target and, with `inverse`, the

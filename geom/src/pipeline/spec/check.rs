@@ -1,12 +1,12 @@
 //! A job checked against its meshes' summaries before any work starts (the server answers
 //! with these errors before it queues a job; the pipeline checks again on the meshes).
 
-use super::anchor_spec::AnchorRow;
-use super::limits::{MAX_ANCHORS, MAX_FEATURES};
-use super::spec::{HomologySpec, JobSpec, LayoutSpec, Method, SphericalSpec};
 use crate::error::{InputError, Result};
 use crate::homology::features::{Curve, check_disjoint, validate_curve};
 use crate::mesh::{Mesh, VertexId};
+use crate::pipeline::spec::anchor_spec::AnchorRow;
+use crate::pipeline::spec::limits::{MAX_ANCHORS, MAX_FEATURES};
+use crate::pipeline::spec::{HomologySpec, JobSpec, LayoutSpec, Method, SphericalSpec};
 use crate::topology::{self, Summary};
 
 impl JobSpec {
@@ -49,7 +49,7 @@ impl JobSpec {
         // The attributes `transfer` carries, when the source's summary records them.
         match summaries.first().and_then(|s| s.attribute_names.as_deref()) {
             Some(names) if !transfer.is_empty() => {
-                super::transfer_output::check_names(&super::transfer_output::parse(transfer)?, names)
+                crate::pipeline::spec::transfer::check_names(&crate::pipeline::spec::transfer::parse(transfer)?, names)
             }
             _ => Ok(()),
         }

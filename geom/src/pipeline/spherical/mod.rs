@@ -1,14 +1,14 @@
 //! `spherical`: both meshes embedded on the sphere bijectively -> each direction's map
 //! optimized on the other's sphere, injective at every step -> metrics -> artifacts. No stage
 //! repairs another's output: a direction whose images stay turned over fails the job as
-//! folded ([`super::folds`]).
+//! folded ([`crate::pipeline::finish::folds`]).
 
-use super::common::{Artifact, Clock, PairReport, artifacts, both};
-use super::spec::SphericalSpec;
 use crate::error::Result;
 use crate::map::SurfaceMap;
 use crate::mesh::{FaceId, Mesh, VertexId};
 use crate::metrics::{MetricsOptions, evaluate_map};
+use crate::pipeline::common::{Artifact, Clock, PairReport, artifacts, both};
+use crate::pipeline::spec::SphericalSpec;
 use crate::progress::{Progress, Stage};
 use crate::sphere::{
     SphereEmbedOptions, SphereEmbedReport, SphereEmbedding, SpherePair, SpherePairOptions, SpherePairReport,

@@ -2,12 +2,12 @@
 //! per-patch composition: compared before smoothing, and when neither wins on every count,
 //! compared again after both are relaxed.
 
-use super::common::both;
 use crate::crossparam::smooth;
 use crate::domain::refine::Refined;
 use crate::error::{Error, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
+use crate::pipeline::common::both;
 use crate::progress::Progress;
 use crate::topology;
 use serde::Serialize;

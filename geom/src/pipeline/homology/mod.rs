@@ -2,20 +2,23 @@
 //! -> canonical bases -> fundamental domains -> maps through the 4g-gon -> anchor snapping ->
 //! relaxation -> metrics -> artifacts (bases and domains included).
 
-use super::common::inverse::InversePair;
-use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
-use super::common::relax::{FinishedPair, finish_pair};
-use super::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
-use super::homology_class::{CandidateReport, ClassPlan, Relaxed, candidate_reports};
-use super::spec::HomologySpec;
-use super::spec::RelaxOptions;
+use crate::pipeline::common::inverse::InversePair;
+use crate::pipeline::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
+use crate::pipeline::common::relax::{FinishedPair, finish_pair};
+use crate::pipeline::common::{Artifact, Clock, PairReport, artifacts, both, json_artifact};
+pub mod class;
+pub mod features;
+
 use crate::error::{Error, Result};
 use crate::homology::HomologyMapResult;
 use crate::homology::map::{class_map, map_between};
 use crate::homology::matching::{reference_frame, reference_h1};
 use crate::homology::sides::{SideDomain, Sides};
 use crate::mesh::{Mesh, VertexId};
+use crate::pipeline::spec::HomologySpec;
+use crate::pipeline::spec::RelaxOptions;
 use crate::progress::{Progress, Stage};
+use class::{CandidateReport, ClassPlan, Relaxed, candidate_reports};
 use serde::Serialize;
 use serde_json::json;
 

@@ -8,12 +8,21 @@
 //! `{"method": "auto", "anchors": [...], "options": {...}}` (also without `method`).
 //! Each method has its own options type; unknown fields are refused at every depth.
 
-use super::anchor_spec::AnchorRow;
-use super::quad_spec::QuadSpec;
+pub(crate) mod anchor_spec;
+pub(crate) mod auto;
+mod check;
+pub(crate) mod limits;
+mod memory;
+pub(crate) mod quad_spec;
+mod ranges;
+pub(crate) mod transfer;
+
 use crate::crossparam::PatchParamOptions;
 use crate::crossparam::smooth::SmoothOptions;
 use crate::domain::LayoutOptions;
 use crate::error::{Error, InputError, Result};
+use anchor_spec::AnchorRow;
+use quad_spec::QuadSpec;
 use serde::{Deserialize, Serialize};
 
 /// Every method a job may name, in [`Method`] order.
@@ -35,7 +44,7 @@ pub enum JobSpec {
     /// Closed genus-0 pairs through bijective sphere embeddings, one injective optimization
     /// (Schmidt, Pieper & Kobbelt 2023; issue 50).
     Spherical(SphericalSpec),
-    /// The pair method that fits the meshes, picked by the service ([`super::auto`]); also a
+    /// The pair method that fits the meshes, picked by the service ([`crate::pipeline::spec::auto`]); also a
     /// spec without `method`.
     Auto(AutoSpec),
 }

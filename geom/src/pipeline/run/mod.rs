@@ -1,14 +1,17 @@
 //! Phase two of a job: a [`Plan`] runs its method, once per part pair for meshes in several
-//! parts ([`parts`]). One pipeline per method: [`voronoi`] for `voronoi` and `greedy`,
-//! [`homology`], [`features`] for `homology` with feature curves or boundaries, [`quad`],
-//! [`spherical`].
+//! parts (paired in `plan/parts.rs`, joined in `join.rs`). One pipeline per method, each a
+//! folder that imports `common` and the spec and no other method: [`layout`] for `voronoi` and
+//! `greedy`, [`homology`] (and [`features`] for `homology` with feature curves or boundaries),
+//! [`quad`], [`spherical`].
 
-use super::parts;
-use super::plan::{MethodPlan, Plan};
-use super::report::{JobReport, MethodOutput};
-use super::{features, homology, quad, spherical, voronoi};
+use super::homology::{self, features};
+use super::{layout, quad, spherical};
 use crate::error::{InputError, Result};
 use crate::mesh::Mesh;
+mod join;
+
+use crate::pipeline::plan::{MethodPlan, Plan};
+use crate::pipeline::report::{JobReport, MethodOutput};
 use crate::progress::Progress;
 
 /// Runs the plan's method on its meshes (or on each part pair, joined).
@@ -22,7 +25,7 @@ pub fn run(plan: &Plan, progress: &mut dyn Progress) -> Result<MethodOutput> {
         let method = plan.method.for_part(&pair.anchors, &pair.boundaries);
         outputs.push(run_method(&method, &pair.meshes, progress)?);
     }
-    parts::join(pp, &plan.meshes, plan.method.method(), plan.output.metric_samples, outputs)
+    join::join(pp, &plan.meshes, plan.method.method(), plan.output.metric_samples, outputs)
 }
 
 /// One pipeline per method.
@@ -38,7 +41,7 @@ fn run_method(plan: &MethodPlan, meshes: &[Mesh], progress: &mut dyn Progress) -
     let (report, artifacts) = match plan {
         MethodPlan::Layout(method, s) => {
             let (a, b) = pair()?;
-            let (r, arts) = voronoi::run(*method, s, a, b, progress)?;
+            let (r, arts) = layout::run(*method, s, a, b, progress)?;
             (JobReport::Layout(r), arts)
         }
         MethodPlan::Homology(s) => {

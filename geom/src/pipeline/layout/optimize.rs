@@ -14,7 +14,6 @@
 //! (1.7–2.0), where the relaxation alone does as well and the optimized maps lost the contest
 //! after seconds of work (figures in `git show 32d23d1:bench/NOTES.md`).
 
-use super::global_choice::{GlobalInputs, RELAXED_AREA_SLACK, domain_lengths};
 use crate::crossparam::global::domain_map::{DomainMapReport, DomainOptimizer};
 use crate::crossparam::global::{Seed, locate, map_through, seed};
 use crate::crossparam::smooth::SourceFrame;
@@ -22,6 +21,7 @@ use crate::error::Result;
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, P3, VertexId};
 use crate::optim::InjectiveNewtonOptions;
+use crate::pipeline::layout::global_choice::{GlobalInputs, RELAXED_AREA_SLACK, domain_lengths};
 use crate::progress::{Progress, Stage};
 use serde::Serialize;
 

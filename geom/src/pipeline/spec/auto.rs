@@ -10,8 +10,8 @@
 //! The choice is made once, from the meshes' summaries; the chosen method's own checks then
 //! apply as if it had been named.
 
-use super::spec::{AutoSpec, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, SphericalSpec};
 use crate::error::{InputError, Result};
+use crate::pipeline::spec::{AutoSpec, HomologyOptions, HomologySpec, JobSpec, LayoutSpec, MapOptions, SphericalSpec};
 use crate::topology::Summary;
 use serde::Serialize;
 

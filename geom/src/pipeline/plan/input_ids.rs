@@ -4,12 +4,12 @@
 //! anchor, feature-curve vertex and quad marker of that mesh goes through
 //! [`InputLayout::welded`]; other inputs' ids are the mesh's already.
 
-use super::anchor_spec::AnchorRow;
-use super::plan::MethodPlan;
-use super::spec::HomologySpec;
 use crate::error::{InputError, Result};
 use crate::mesh::InputLayout;
 use crate::mesh::layout::VertexIds;
+use crate::pipeline::plan::MethodPlan;
+use crate::pipeline::spec::HomologySpec;
+use crate::pipeline::spec::anchor_spec::AnchorRow;
 
 fn map_id(id: &mut u64, table: Option<&[u32]>, mesh: usize) -> Result<()> {
     if let Some(t) = table {

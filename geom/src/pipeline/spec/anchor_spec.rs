@@ -1,7 +1,7 @@
 //! A pair job's anchor rows: vertex ids `[s, t]`, or a surface point on each mesh, given as a
 //! position (`[x, y, z]`, snapped to the nearest surface point) or as a face and barycentric
 //! coordinates (`{"face": f, "bary": [u, v, w]}`). Point rows are resolved into vertex ids
-//! (inserting a vertex where none lies close) by [`super::anchor_points`] before a method runs.
+//! (inserting a vertex where none lies close) by [`crate::pipeline::plan::anchor_points`] before a method runs.
 
 use crate::error::{InputError, Result};
 use serde::{Deserialize, Deserializer, Serialize};
@@ -98,7 +98,7 @@ impl PointRef {
 /// The vertex-id rows of a resolved spec.
 ///
 /// # Errors
-/// `Internal` if a point row was not resolved (a bug: [`super::run_with_layouts`] resolves them).
+/// `Internal` if a point row was not resolved (a bug: [`crate::pipeline::run_with_layouts`] resolves them).
 pub fn id_rows(rows: &[AnchorRow]) -> Result<Vec<[u64; 2]>> {
     rows.iter()
         .map(|r| match r {

@@ -2,12 +2,12 @@
 //! uniform or adaptive remesh -> geometry images and normal maps -> morphs -> metrics, with
 //! progress, cancellation and per-stage timings.
 
-use super::common::{Artifact, Clock};
-use super::quad_spec::{MorphDomain, QuadSpec};
 use crate::error::{Error, Result};
 use crate::io::{self, Format};
 use crate::mesh::{Mesh, P3};
 use crate::metrics::hausdorff;
+use crate::pipeline::common::{Artifact, Clock};
+use crate::pipeline::spec::quad_spec::{MorphDomain, QuadSpec};
 use crate::progress::{Progress, Stage};
 use crate::quad::consistent::{ConsistentOptions, ConsistentResult, consistent_parameterization};
 use crate::quad::remesh::{RemeshGrid, sample_uniform, sample_with_normals, uniform_grid};

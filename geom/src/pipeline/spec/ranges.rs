@@ -5,14 +5,14 @@
 //!
 //! The bounds are generous: each is one to two orders of magnitude above anything a measured
 //! case has needed, and small enough that the job's memory stays proportional to its meshes
-//! (see [`super::memory`]).
+//! (see [`crate::pipeline::spec::memory`]).
 
-use super::quad_spec::QuadOptions;
-use super::spec::{HomologyOptions, MapOptions, SphericalOptions};
 use crate::crossparam::smooth::SmoothOptions;
 use crate::error::{InputError, Result};
+use crate::pipeline::spec::quad_spec::QuadOptions;
+use crate::pipeline::spec::{HomologyOptions, MapOptions, SphericalOptions};
 
-use super::limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_METRIC_SAMPLES, MAX_MORPH_FRAMES};
+use crate::pipeline::spec::limits::{MAX_ANCHORS, MAX_EDGE_NODES, MAX_METRIC_SAMPLES, MAX_MORPH_FRAMES};
 
 fn out_of_range(field: &str, value: impl std::fmt::Display, range: &str) -> crate::error::Error {
     InputError::OptionRange(format!("options.{field} = {value} is outside its range {range}")).into()
@@ -61,7 +61,7 @@ impl MapOptions {
         real("layout.flip.max_end_angle", l.flip.max_end_angle, 0.0, 1.0, true)?;
         size("param.stretch_iterations", self.param.stretch_iterations, 0, 100)?;
         smoothing(&self.smoothing)?;
-        super::transfer_output::parse(&self.transfer)?;
+        crate::pipeline::spec::transfer::parse(&self.transfer)?;
         size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)
     }
 }
@@ -79,7 +79,7 @@ impl HomologyOptions {
         if let Some(r) = self.rotation {
             size("rotation", r, 0, 1_000)?;
         }
-        super::transfer_output::parse(&self.transfer)?;
+        crate::pipeline::spec::transfer::parse(&self.transfer)?;
         if let Some(d) = self.dihedral_threshold_deg {
             real("dihedral_threshold_deg", d, 0.0, 180.0, true)?;
         }
@@ -100,7 +100,7 @@ impl SphericalOptions {
     /// # Errors
     /// `InputError::OptionRange` naming the first field out of range and the range.
     pub fn check_ranges(&self) -> Result<()> {
-        super::transfer_output::parse(&self.transfer)?;
+        crate::pipeline::spec::transfer::parse(&self.transfer)?;
         size("metric_samples", self.metric_samples, 100, MAX_METRIC_SAMPLES as u64)
     }
 }
@@ -149,7 +149,10 @@ impl QuadOptions {
         }
         // The wavelet morph analyses the uniform grid: an adaptive remesh has none (the run
         // would fail after the whole parameterization).
-        if m.frames > 0 && m.domain == super::quad_spec::MorphDomain::Wavelet && self.adaptive_epsilon.is_some() {
+        if m.frames > 0
+            && m.domain == crate::pipeline::spec::quad_spec::MorphDomain::Wavelet
+            && self.adaptive_epsilon.is_some()
+        {
             return Err(InputError::OptionRange(
                 "options.morph.domain = \"wavelet\" needs uniform remeshing: drop options.adaptive_epsilon, or use the spatial morph".into(),
             )
@@ -194,7 +197,7 @@ mod tests {
     fn a_wavelet_morph_of_an_adaptive_remesh_is_refused_before_running() {
         let mut q = QuadOptions { adaptive_epsilon: Some(0.01), ..Default::default() };
         q.morph.frames = 3;
-        q.morph.domain = super::super::quad_spec::MorphDomain::Wavelet;
+        q.morph.domain = crate::pipeline::spec::quad_spec::MorphDomain::Wavelet;
         let e = q.check_ranges(2).unwrap_err();
         assert_eq!(e.code(), "option_out_of_range");
         assert!(e.to_string().contains("adaptive_epsilon"), "{e}");

@@ -1,11 +1,11 @@
 //! The spec of a `quad` job over N meshes (`surfmap remesh`, the server's N-mesh jobs):
 //! `{"method": "quad", "anchors": [[v_1, ..., v_N], ...], "options": {...}}` (the `quad` variant
-//! of [`super::JobSpec`]), validated against the meshes before any work starts. The first four anchor rows are the partition points, the
+//! of [`crate::pipeline::JobSpec`]), validated against the meshes before any work starts. The first four anchor rows are the partition points, the
 //! rest (and `options.feature_anchors`) are feature points.
 
-use super::limits::{MAX_ANCHORS, MAX_MODELS};
 use crate::error::{InputError, Result};
 use crate::mesh::VertexId;
+use crate::pipeline::spec::limits::{MAX_ANCHORS, MAX_MODELS};
 pub use crate::quad::morph::{Interpolation, LevelSchedule};
 use crate::topology;
 use serde::{Deserialize, Serialize};

@@ -1,5 +1,5 @@
 //! The size limits of a job, one table for every method: what a spec may ask for at most.
-//! Checked before a job is queued ([`super::check`], [`super::ranges`]).
+//! Checked before a job is queued ([`crate::pipeline::spec::check`], [`crate::pipeline::spec::ranges`]).
 
 /// Most anchors (anchor rows of a `quad` job) a job may have.
 pub const MAX_ANCHORS: usize = 4096;

@@ -4,7 +4,7 @@
 //! to measured peaks (the resident set of `surfmap map` / `surfmap remesh`; `git show 32d23d1:bench/NOTES.md`)
 //! and rounded up, so the estimate errs high.
 
-use super::spec::JobSpec;
+use crate::pipeline::spec::JobSpec;
 use crate::topology::Summary;
 
 /// Fixed cost of any job's process: its mapped executable, thread stacks and two allocator

@@ -2,13 +2,13 @@
 //! parameterization -> composition -> global map choice -> relaxation -> metrics -> artifacts,
 //! with progress, cancellation and per-stage timings.
 
-use super::common::inverse::InversePair;
-use super::common::relax::{Direction, finish_direction, measure_direction, relax_chords, relax_local};
-use super::common::{Artifact, Clock, PairReport, VISIBLE, artifacts, both, on_surface};
-use super::global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
-use super::open_loops::{BoundaryReport, OpenPlan};
-use super::optimize::{self, OptimizeReport, Quality};
-use super::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
+use crate::pipeline::common::inverse::InversePair;
+use crate::pipeline::common::relax::{Direction, finish_direction, measure_direction, relax_chords, relax_local};
+use crate::pipeline::common::{Artifact, Clock, PairReport, VISIBLE, artifacts, both, on_surface};
+mod global_choice;
+pub(crate) mod open_loops;
+mod optimize;
+
 use crate::crossparam::global::GlobalParamOptions;
 use crate::crossparam::smooth::SmoothReport;
 use crate::crossparam::{compose, parameterize_patches, parameterize_patches_with};
@@ -18,8 +18,12 @@ use crate::domain::{LayoutStats, greedy, patches_of, voronoi};
 use crate::error::{Error, InputError, Result};
 use crate::map::SurfaceMap;
 use crate::mesh::{Mesh, VertexId};
+use crate::pipeline::spec::{LayoutSpec, MapOptions, Method, RelaxOptions};
 use crate::progress::{Progress, Stage};
 use crate::topology;
+use global_choice::{GlobalInputs, GlobalReport, RelaxedComparison, choose_global, relaxed_quality};
+use open_loops::{BoundaryReport, OpenPlan};
+use optimize::{OptimizeReport, Quality};
 use serde::Serialize;
 
 /// What a `voronoi` or `greedy` job measured (`metrics.json`).
@@ -347,7 +351,7 @@ fn run_with(
     progress: &mut dyn Progress,
 ) -> Result<(LayoutMapReport, Vec<Artifact>)> {
     let mut clock = Clock::start();
-    super::open_loops::check_loop_counts(source, target)?;
+    crate::pipeline::layout::open_loops::check_loop_counts(source, target)?;
     let pairs = spec.validate(method, source, target)?;
     let o = &spec.options;
     let open = (!topology::boundary_loops(source).is_empty() || !topology::boundary_loops(target).is_empty())
@@ -442,7 +446,7 @@ pub(super) fn outputs(
 }
 
 /// `voronoi` and `greedy` on open meshes: the layout and composition on the meshes closed by
-/// cones ([`super::open_loops`]), the maps restricted to the open meshes, then relaxation (which
+/// cones ([`crate::pipeline::layout::open_loops`]), the maps restricted to the open meshes, then relaxation (which
 /// keeps boundary images on the boundary) and the evaluator's metrics there. The base-domain
 /// global map and optimization are closed-surface stages (they move images across layout
 /// paths, which here include the loops) and do not run.

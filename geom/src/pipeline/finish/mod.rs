@@ -3,11 +3,14 @@
 //! their seams, [`layout_outputs`]; `target_transferred.glb`, [`transfer_output`]); and
 //! `metrics.json` is written, here and nowhere else, from the final report.
 
-use super::common::{Artifact, json_artifact};
-use super::plan::Plan;
-use super::report::{JobReport, MethodOutput};
-use super::{folds, layout_outputs, transfer_output};
+mod folds;
+mod layout_outputs;
+mod transfer_output;
+
 use crate::error::Result;
+use crate::pipeline::common::{Artifact, json_artifact};
+use crate::pipeline::plan::Plan;
+use crate::pipeline::report::{JobReport, MethodOutput};
 
 /// Checks, completes and measures a method's output.
 ///

@@ -1,16 +1,10 @@
-//! Meshes in several parts (eyes, teeth beside a head): the parts pair up through the anchors
-//! ([`plan`], in the plan phase), each pair is mapped by the job's method on its own, and the
-//! maps are joined into one map of the whole meshes, measured as a whole ([`join`]). A part with
-//! no anchor, or anchors that pair one part with two, is a typed error naming the part.
+//! Meshes in several parts (eyes, teeth beside a head): the parts pair up through the anchors.
+//! Each pair is then mapped by the job's method on its own and the maps joined
+//! ([`crate::pipeline::run`]). A part with no anchor, or anchors that pair one part with two, is a
+//! typed error naming the part.
 
-use super::common::artifacts::maps_and_meshes as artifacts_of_maps;
-use super::common::{Artifact, PairReport};
-use super::report::{JobReport, MethodOutput, PartsReport};
-use super::spec::Method;
 use crate::error::{InputError, Result};
-use crate::map::SurfaceMap;
-use crate::mesh::{FaceId, Mesh, VertexId};
-use crate::metrics::{MetricsOptions, evaluate_map};
+use crate::mesh::Mesh;
 use crate::topology::{self, components};
 
 /// One connected component as a mesh of its own.
@@ -28,9 +22,9 @@ pub struct PartPair {
     /// The source part's mesh, then the target part's.
     pub meshes: [Mesh; 2],
     /// Local vertex -> whole vertex, per side.
-    vertices: [Vec<u32>; 2],
+    pub vertices: [Vec<u32>; 2],
     /// Local face -> whole face, per side.
-    faces: [Vec<u32>; 2],
+    pub faces: [Vec<u32>; 2],
     pub anchors: Vec<[u64; 2]>,
     pub boundaries: Vec<[u64; 2]>,
 }
@@ -39,9 +33,9 @@ pub struct PartPair {
 pub struct PartsPlan {
     pub pairs: Vec<PartPair>,
     /// `[source part, target part]` per pair.
-    part_pairs: Vec<[usize; 2]>,
+    pub part_pairs: Vec<[usize; 2]>,
     /// The whole job's anchors.
-    rows: Vec<[u64; 2]>,
+    pub rows: Vec<[u64; 2]>,
 }
 
 fn split(m: &Mesh) -> Result<(Vec<Part>, Vec<u32>)> {
@@ -168,53 +162,4 @@ pub fn plan(meshes: &[Mesh], rows: &[[u64; 2]], boundaries: &[[u64; 2]]) -> Resu
     }
     let part_pairs = partner.iter().enumerate().map(|(a, &b)| [a, b]).collect();
     Ok(Some(PartsPlan { pairs, part_pairs, rows }))
-}
-
-/// Joins each part pair's maps into the whole meshes' maps, measured as a whole; each part's
-/// artifacts come with a `partK_` prefix.
-///
-/// # Errors
-/// `Internal` when a part's report has no maps; the metrics' errors.
-pub fn join(
-    plan: &PartsPlan,
-    meshes: &[Mesh],
-    method: Method,
-    samples: usize,
-    outputs: Vec<MethodOutput>,
-) -> Result<MethodOutput> {
-    let [s, t] = meshes else { return Err(crate::Error::Internal("a parts job without two meshes".into())) };
-    let mut parts = Vec::with_capacity(outputs.len());
-    let mut arts = Vec::new();
-    let (mut s2t, mut t2s) = (
-        SurfaceMap { face: vec![FaceId(0); s.n_vertices()], bary: vec![[0.0; 3]; s.n_vertices()] },
-        SurfaceMap { face: vec![FaceId(0); t.n_vertices()], bary: vec![[0.0; 3]; t.n_vertices()] },
-    );
-    for (a, (pair, out)) in plan.pairs.iter().zip(outputs).enumerate() {
-        let rep = out.report;
-        let maps =
-            rep.pair().and_then(|p| p.maps.clone()).ok_or_else(|| crate::Error::Internal("a part's maps".into()))?;
-        let ([sv, tv], [sf, tf]) = (&pair.vertices, &pair.faces);
-        for (i, &v) in sv.iter().enumerate() {
-            s2t.face[v as usize] = FaceId(tf[maps.s2t.face[i].idx()]);
-            s2t.bary[v as usize] = maps.s2t.bary[i];
-        }
-        for (i, &v) in tv.iter().enumerate() {
-            t2s.face[v as usize] = FaceId(sf[maps.t2s.face[i].idx()]);
-            t2s.bary[v as usize] = maps.t2s.bary[i];
-        }
-        arts.extend(out.artifacts.into_iter().map(|x| Artifact { name: format!("part{a}_{}", x.name), ..x }));
-        parts.push(rep);
-    }
-    let mo = MetricsOptions { samples, ..Default::default() };
-    let (on_target, on_source) = (s2t.embed(s, t)?, t2s.embed(t, s)?);
-    let anchors: Vec<(VertexId, VertexId)> =
-        plan.rows.iter().map(|r| (VertexId(r[0] as u32), VertexId(r[1] as u32))).collect();
-    let back_anchors: Vec<(VertexId, VertexId)> = anchors.iter().map(|&(a, b)| (b, a)).collect();
-    let m1 = evaluate_map(s, t, &on_target, Some(&anchors), None, &mo)?;
-    let m2 = evaluate_map(t, s, &on_source, Some(&back_anchors), None, &mo)?;
-    arts.extend(artifacts_of_maps(&s2t, &t2s, &on_target, &on_source));
-    let pair =
-        PairReport::new(method.name(), plan.rows.len(), (s, t), (m1, m2), Default::default()).with_maps(s2t, t2s);
-    let report = JobReport::Parts(Box::new(PartsReport { pair, part_pairs: plan.part_pairs.clone(), parts }));
-    Ok(MethodOutput { report, artifacts: arts })
 }

@@ -5,16 +5,20 @@
 //! and the options every pair method shares become one [`OutputOptions`]. A plan is only read
 //! after this; nothing turns it back into a spec.
 
-use super::anchor_points::{self, AnchorSnap};
-use super::anchor_spec::{AnchorRow, id_rows};
-use super::auto::AutoChoice;
-use super::parts::{self, PartsPlan};
-use super::quad_spec::QuadSpec;
-use super::spec::{HomologySpec, JobSpec, LayoutSpec, Method, SphericalSpec};
-use super::{input_ids, transfer_output};
+pub(crate) mod anchor_points;
+mod input_ids;
+pub(crate) mod parts;
+
 use crate::error::{Error, Result};
 use crate::map::transfer::TransferOptions;
 use crate::mesh::{InputLayout, Mesh};
+use crate::pipeline::spec::anchor_spec::{AnchorRow, id_rows};
+use crate::pipeline::spec::auto::AutoChoice;
+use crate::pipeline::spec::quad_spec::QuadSpec;
+use crate::pipeline::spec::transfer;
+use crate::pipeline::spec::{HomologySpec, JobSpec, LayoutSpec, Method, SphericalSpec};
+use anchor_points::AnchorSnap;
+use parts::PartsPlan;
 use std::borrow::Cow;
 
 /// The method to run and its own spec: a [`JobSpec`] with `auto` resolved, whose vertex ids
@@ -118,7 +122,7 @@ impl OutputOptions {
             JobSpec::Auto(s) => (s.options.metric_samples, &s.options.transfer, s.options.inverse_morph),
             JobSpec::Quad(s) => (s.options.metric_samples, &Vec::new(), false),
         };
-        Ok(OutputOptions { metric_samples, transfer: transfer_output::parse(transfer)?, inverse_morph })
+        Ok(OutputOptions { metric_samples, transfer: transfer::parse(transfer)?, inverse_morph })
     }
 
     /// Whether any attribute is carried.
@@ -168,7 +172,7 @@ impl<'a> Plan<'a> {
         let mut method = MethodPlan::new(spec)?;
         input_ids::to_welded(&mut method, &layouts)?;
         if let (true, Some(source)) = (output.wants_transfer(), meshes.first()) {
-            transfer_output::check_source(&output.transfer, source, layouts.first().copied().flatten())?;
+            transfer::check_source(&output.transfer, source, layouts.first().copied().flatten())?;
         }
         let (meshes_run, snaps) = match anchor_points::resolve(&mut method, meshes)? {
             Some((inserted, snaps)) => (Cow::Owned(inserted), snaps),

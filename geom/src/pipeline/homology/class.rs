@@ -2,12 +2,12 @@
 //! rotation, or a curve matching realized by them), or, with none named, the natural-class
 //! candidates of [`crate::homology::natural`], least stretched first.
 
-use super::spec::ClassChoice;
 use crate::error::Result;
 use crate::homology::matching::{MatchingOptions, find_matching, parse_matching};
 use crate::homology::natural::{ClassCandidate, NaturalClassOptions, natural_classes};
 use crate::homology::sides::Sides;
 use crate::mesh::VertexId;
+use crate::pipeline::spec::ClassChoice;
 use crate::progress::Progress;
 use serde::Serialize;
 
@@ -96,7 +96,7 @@ pub struct Relaxed {
 
 impl Relaxed {
     /// The outcome of a relaxed pair.
-    pub fn of(f: &super::common::relax::FinishedPair) -> Relaxed {
+    pub fn of(f: &crate::pipeline::common::relax::FinishedPair) -> Relaxed {
         Relaxed { flips: [f.m1.flipped_faces, f.m2.flipped_faces], l2_stretch: [f.m1.l2_stretch, f.m2.l2_stretch] }
     }
 

@@ -3,10 +3,6 @@
 //! domains -> maps both ways -> anchor snapping -> smoothing with every feature vertex held ->
 //! metrics (with the feature error) -> artifacts.
 
-use super::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
-use super::common::relax::finish_pair;
-use super::common::{Artifact, Clock, PairReport, artifacts, json_artifact};
-use super::spec::{ClassChoice, HomologySpec};
 use crate::error::Result;
 use crate::homology::CanonicalBasisResult;
 use crate::homology::curve_align::CurveAlignOptions;
@@ -14,6 +10,10 @@ use crate::homology::feature_cut::{FeatureCutResult, Side, SideKind};
 use crate::homology::feature_map::{FeatureMapOptions, FeatureSide, feature_error, feature_map};
 use crate::homology::features::{Curve, CurveKind};
 use crate::mesh::{Mesh, VertexId};
+use crate::pipeline::common::meta_mesh::{MetaMeshStats, loops_json, meta_outputs, planar_obj};
+use crate::pipeline::common::relax::finish_pair;
+use crate::pipeline::common::{Artifact, Clock, PairReport, artifacts, json_artifact};
+use crate::pipeline::spec::{ClassChoice, HomologySpec};
 use crate::progress::{Progress, Stage};
 use serde::Serialize;
 use serde_json::json;

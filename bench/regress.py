@@ -37,7 +37,7 @@ def fingerprint(out):
     arts = {}
     for name in sorted(os.listdir(out)):
         data = open(os.path.join(out, name), "rb").read()
-        if name == "metrics.json":
+        if name.endswith("metrics.json"):
             arts[name] = untimed(json.loads(data))
         else:
             arts[name] = hashlib.sha256(data).hexdigest()

@@ -3,10 +3,10 @@
 //! vertex (or 1% of the face's shortest edge, so no sliver is made) the anchor is that vertex,
 //! else a vertex is inserted there (`mesh::insert`). Each snap's distance is reported.
 
+use super::method::MethodPlan;
 use crate::error::{InputError, Result};
 use crate::mesh::insert::insert_points;
 use crate::mesh::{FaceId, Mesh, P3};
-use crate::pipeline::plan::MethodPlan;
 use crate::pipeline::spec::anchor_spec::{AnchorRow, PointRef};
 use crate::topology::Locator;
 use serde::Serialize;

@@ -4,10 +4,10 @@
 //! anchor, feature-curve vertex and quad marker of that mesh goes through
 //! [`InputLayout::welded`]; other inputs' ids are the mesh's already.
 
+use super::method::MethodPlan;
 use crate::error::{InputError, Result};
 use crate::mesh::InputLayout;
 use crate::mesh::layout::VertexIds;
-use crate::pipeline::plan::MethodPlan;
 use crate::pipeline::spec::HomologySpec;
 use crate::pipeline::spec::anchor_spec::AnchorRow;
 

@@ -308,11 +308,29 @@ fn pipeline_methods_and_phases_import_downward() {
             }
         }
         let phase = |p: &str| PHASES.iter().position(|d| p.starts_with(*d));
-        if let (Some(a), Some(b)) = (phase(from), phase(to)) {
-            if b > a {
-                errors.push(format!("phase file {from} imports the later phase's {to}"));
-            }
+        if let (Some(a), Some(b)) = (phase(from), phase(to))
+            && b > a
+        {
+            errors.push(format!("phase file {from} imports the later phase's {to}"));
         }
     }
     assert!(errors.is_empty(), "the pipeline imports upward:\n{}", errors.join("\n"));
+}
+
+/// `mesh` is the ground floor of `geom`: its files import only each other, `error` and `tol`.
+#[test]
+fn the_mesh_model_imports_nothing_above_it() {
+    let files: Vec<(String, String)> = sources().into_iter().filter(|(p, _)| p.starts_with("geom/src/")).collect();
+    let g = imports::graph("geom/src", &files);
+    let below = ["geom/src/error.rs", "geom/src/tol.rs", "geom/src/lib.rs"];
+    let errors: Vec<String> = g
+        .iter()
+        .filter(|(f, _)| f.starts_with("geom/src/mesh/"))
+        .flat_map(|(f, ts)| {
+            ts.iter()
+                .filter(|t| !t.starts_with("geom/src/mesh/") && !below.contains(&t.as_str()))
+                .map(move |t| format!("{f} imports {t}"))
+        })
+        .collect();
+    assert!(errors.is_empty(), "the mesh model imports upward:\n{}", errors.join("\n"));
 }

@@ -5,7 +5,6 @@
 //! ([`Capped::restrict`]).
 
 use crate::error::{Error, InputError, Result};
-use crate::map::SurfaceMap;
 use crate::mesh::{FaceId, HalfedgeId, Mesh, P3, VertexId};
 
 /// One closed boundary loop.
@@ -41,7 +40,7 @@ pub fn cap_loops(mesh: &Mesh) -> Result<Capped> {
     let mut loops = Vec::new();
     let mut across = Vec::new();
     let mut on_loop = vec![false; nv];
-    for hs in crate::topology::boundary_loops(mesh) {
+    for hs in super::loops::boundary_loops(mesh) {
         let vertices: Vec<VertexId> = hs.iter().map(|&h| mesh.tail(h)).collect();
         if vertices.len() < 3 || vertices.iter().any(|v| std::mem::replace(&mut on_loop[v.idx()], true)) {
             return Err(InputError::TopologyMismatch(format!(
@@ -123,23 +122,25 @@ impl Capped {
         })
     }
 
-    /// `map` (from a closed mesh onto this one) restricted to the first `from_vertices` source
-    /// vertices (the open source's), every image on the open mesh. Images on a loop keep
-    /// exactly to the loop edge (an open face's off-edge weight at most `tol` is zeroed).
+    /// A map from a closed mesh onto this one, as each source vertex's `(face, bary)`,
+    /// restricted to the first `from_vertices` source vertices (the open source's), every image
+    /// on the open mesh. Images on a loop keep exactly to the loop edge (an open face's off-edge
+    /// weight at most `tol` is zeroed). (Plain vectors, not a `map::SurfaceMap`: the mesh
+    /// module imports nothing above it.)
     ///
     /// # Errors
     /// `Error::Numerical` when an open vertex maps inside a cone.
     pub fn restrict_map(
         &self,
-        map: &SurfaceMap,
+        (faces, barys): (&[FaceId], &[[f64; 3]]),
         from_vertices: usize,
         on_loop: &[bool],
         tol: f64,
-    ) -> Result<SurfaceMap> {
+    ) -> Result<(Vec<FaceId>, Vec<[f64; 3]>)> {
         let mut face = Vec::with_capacity(from_vertices);
         let mut bary = Vec::with_capacity(from_vertices);
         for (v, &looped) in on_loop.iter().enumerate().take(from_vertices) {
-            let (f, mut b) = self.restrict(map.face[v], map.bary[v], tol).ok_or_else(|| {
+            let (f, mut b) = self.restrict(faces[v], barys[v], tol).ok_or_else(|| {
                 Error::Numerical(format!("vertex {v} of the open mesh maps inside the cap of a boundary loop"))
             })?;
             if looped {
@@ -148,7 +149,7 @@ impl Capped {
             face.push(f);
             bary.push(b);
         }
-        Ok(SurfaceMap { face, bary })
+        Ok((face, bary))
     }
 }
 

@@ -13,6 +13,7 @@ mod cut_copy;
 mod ids;
 pub mod insert;
 pub mod layout;
+mod loops;
 pub mod refine;
 pub mod shapes;
 mod triangulate;
@@ -20,6 +21,7 @@ mod triangulate;
 pub use build::{MeshLimits, RawMesh, Warning};
 pub use ids::{EdgeId, ElementData, FaceData, FaceId, HalfedgeId, VertexData, VertexId};
 pub use layout::{Attributes, InputLayout, SplitMesh};
+pub use loops::boundary_loops;
 pub use triangulate::triangulate_polygon;
 
 use nalgebra::{Point3, Vector3};

@@ -5,14 +5,13 @@
 mod admit;
 mod components;
 mod locate;
-mod loops;
 mod surface_point;
 
+pub use crate::mesh::boundary_loops;
 pub use admit::checked_summary;
 pub use components::{Components, PartSummary, components, parts};
 pub(crate) use locate::plane_barycentric;
 pub use locate::{Locator, Projection};
-pub use loops::boundary_loops;
 pub use surface_point::SurfacePoint;
 
 use crate::mesh::Mesh;

@@ -141,8 +141,12 @@ impl OpenPlan {
     /// `Error::Numerical` when a vertex of an open mesh maps inside a cone.
     pub fn restrict(&self, s2t: &SurfaceMap, t2s: &SurfaceMap) -> Result<(SurfaceMap, SurfaceMap)> {
         let (on_s, on_t) = (on_loops(&self.source), on_loops(&self.target));
-        let a = self.target.restrict_map(s2t, self.source.open_vertices, &on_s, ON_LOOP)?;
-        let b = self.source.restrict_map(t2s, self.target.open_vertices, &on_t, ON_LOOP)?;
+        let (face, bary) =
+            self.target.restrict_map((&s2t.face, &s2t.bary), self.source.open_vertices, &on_s, ON_LOOP)?;
+        let a = SurfaceMap { face, bary };
+        let (face, bary) =
+            self.source.restrict_map((&t2s.face, &t2s.bary), self.target.open_vertices, &on_t, ON_LOOP)?;
+        let b = SurfaceMap { face, bary };
         Ok((a, b))
     }
 

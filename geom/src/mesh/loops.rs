@@ -1,6 +1,6 @@
 //! Boundary loops: cycles of boundary half-edges, each listed in order.
 
-use crate::mesh::{HalfedgeId, Mesh};
+use super::{HalfedgeId, Mesh};
 
 /// Boundary loops, each a list of boundary half-edges in order (the head of one is the tail of
 /// the next). The interior of the mesh lies to the left of each half-edge.

@@ -334,3 +334,22 @@ fn the_mesh_model_imports_nothing_above_it() {
         .collect();
     assert!(errors.is_empty(), "the mesh model imports upward:\n{}", errors.join("\n"));
 }
+
+/// `geom`'s top-level modules (`mesh`, `topology`, ..., `pipeline`) import each other as a DAG:
+/// the file graph collapsed to modules has no cycle.
+#[test]
+fn geom_modules_form_a_dag() {
+    let files: Vec<(String, String)> = sources().into_iter().filter(|(p, _)| p.starts_with("geom/src/")).collect();
+    let module = |p: &str| {
+        let rest = &p["geom/src/".len()..];
+        rest.split('/').next().unwrap_or(rest).trim_end_matches(".rs").to_string()
+    };
+    let mut modules: BTreeMap<String, std::collections::BTreeSet<String>> = BTreeMap::new();
+    for (from, to) in imports::graph("geom/src", &files) {
+        let a = module(&from);
+        let set = modules.entry(a.clone()).or_default();
+        set.extend(to.iter().map(|t| module(t)).filter(|b| *b != a && b != "lib"));
+    }
+    let cyc = imports::cycles(&modules);
+    assert!(cyc.is_empty(), "geom modules import each other in a circle: {cyc:?}");
+}

@@ -1,7 +1,7 @@
 //! File-level imports: which source file of a crate names which other (issue 52's cycle check).
 //!
-//! A file's module path comes from where it sits (`geom/src/pipeline/spec.rs` is
-//! `crate::pipeline::spec`, a `mod.rs` is its folder). Every path in its code that starts with
+//! A file's module path comes from where it sits (`geom/src/pipeline/plan/parts.rs` is
+//! `crate::pipeline::plan::parts`, a `mod.rs` is its folder). Every path in its code that starts with
 //! `crate::`, `super::` or `self::` (in `use` statements, braces expanded, and inline) is
 //! resolved to the longest module prefix that is a file: an edge from the file to that file.
 //! Re-exports (`pub use`) only name things and make no edge; test modules (from the first

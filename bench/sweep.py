@@ -4,10 +4,13 @@ twist and bend, shuffled vertex order, farthest-point anchors, the true correspo
 by each method that applies, judged by the shared evaluator. Cases are drawn from a seed that is
 printed, so any run can be repeated.
 
-Usage: python3 bench/sweep.py SURFMAP_BINARY [--seed N] [--cases N] [--max-vertices V] [--only I ...]
-                              [--check] [--require-ok]
+Usage: python3 bench/sweep.py SURFMAP_BINARY [--seed N] [--cases N] [--max-vertices V] [--max-genus G]
+                              [--method M] [--only I ...] [--check] [--require-ok]
   --cases        how many cases to draw (default 150)
   --max-vertices only meshes up to this size (default: all)
+  --max-genus    only meshes up to this genus (default: all)
+  --method       every case with this method (auto, spherical, ...) in place of the drawn one; the
+                 draw is the same, so a case index names the same mesh and anchors either way
   --only         run only these case indices of the draw (the others are drawn, not run)
   --check        exit 1 on a defect: a success with flipped faces, anchors off their partners,
                  a map off the surface, or an internal error or crash (CI runs a slice this way)
@@ -49,12 +52,12 @@ def closed_meshes():
     return out
 
 
-def draw(rng, meshes):
+def draw(rng, meshes, forced=None):
     path, nv, genus = meshes[rng.integers(len(meshes))]
     methods = ["voronoi", "greedy"] + (["homology"] if genus >= 1 else [])
     method = methods[rng.integers(len(methods))]
     anchors = 1 if method == "homology" else int(rng.integers(6, 46))
-    return {"mesh": path, "vertices": nv, "genus": genus, "method": method, "anchors": anchors,
+    return {"mesh": path, "vertices": nv, "genus": genus, "method": forced or method, "anchors": anchors,
             "mkcase_seed": int(rng.integers(1, 1 << 30)), "strength": round(float(rng.uniform(0.5, 1.0)), 3)}
 
 
@@ -98,19 +101,21 @@ def main():
     ap.add_argument("--seed", type=int, default=int(time.time()) % 100000)
     ap.add_argument("--cases", type=int, default=150)
     ap.add_argument("--max-vertices", type=int, default=1 << 40)
+    ap.add_argument("--max-genus", type=int, default=1 << 40)
+    ap.add_argument("--method")
     ap.add_argument("--only", type=int, nargs="+")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--require-ok", action="store_true")
     a = ap.parse_args()
     if a.only:
         a.cases = max(a.cases, max(a.only) + 1)
-    meshes = [m for m in closed_meshes() if m[1] <= a.max_vertices]
+    meshes = [m for m in closed_meshes() if m[1] <= a.max_vertices and m[2] <= a.max_genus]
     print(f"seed {a.seed}, {a.cases} cases over {len(meshes)} closed meshes", flush=True)
     rng = np.random.default_rng(a.seed)
     counts, must_miss, defects = collections.Counter(), [], []
     with tempfile.TemporaryDirectory() as tmp:
         for i in range(a.cases):
-            c = draw(rng, meshes)
+            c = draw(rng, meshes, a.method)
             if a.only and i not in a.only:
                 continue
             r = run_case(a.binary, c, tmp)

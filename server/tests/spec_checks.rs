@@ -85,7 +85,7 @@ async fn a_transfer_of_a_missing_attribute_is_refused_before_queueing() {
 }
 
 /// A spec without `method` is an `auto` job: queued as such, and the chosen method's checks
-/// apply at submission (here `spherical`'s 3 anchors).
+/// apply at submission (here anchors inside the meshes).
 #[tokio::test]
 async fn a_spec_without_method_is_queued_as_auto_and_checked_as_the_method_it_picks() {
     let t = setup().await;

@@ -146,13 +146,21 @@ impl SphereNewton {
     /// # Errors
     /// `Invalid` for a vertex outside the mesh, fixed, or in no triangle.
     pub fn set_pull(&mut self, goals: &[(u32, P3)], weight: f64) -> Result<()> {
+        // One triangle and corner per vertex, found in one pass (not a scan per goal).
+        let mut slot_of = vec![None; self.fixed.len()];
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for (k, &x) in tri.iter().enumerate() {
+                if let Some(slot @ None) = slot_of.get_mut(x as usize) {
+                    *slot = Some((t, k));
+                }
+            }
+        }
         let mut out = Vec::with_capacity(goals.len());
         for &(v, g) in goals {
-            let slot = self
-                .triangles
-                .iter()
-                .enumerate()
-                .find_map(|(t, tri)| tri.iter().position(|&x| x == v).map(|k| (t, k)))
+            let slot = slot_of
+                .get(v as usize)
+                .copied()
+                .flatten()
                 .filter(|_| !self.fixed.get(v as usize).copied().unwrap_or(true))
                 .ok_or_else(|| InputError::Invalid(format!("vertex {v} cannot be pulled")))?;
             out.push((v, g, slot.0, slot.1));

@@ -130,7 +130,7 @@ fn locate(mesh: &Mesh, f: usize, anchors: &[[u64; 2]], side: usize, name: &str) 
 fn remedies(plan: &MethodPlan) -> &'static str {
     match plan {
         MethodPlan::Layout(..) => {
-            "Add anchors near these faces, or check that the anchors keep the same order around each other on both meshes (anchors that cross on one mesh and not the other fold any map)"
+            "Add anchors near these faces, or check that the anchors keep the same order around each other on both meshes (anchors that cross on one mesh and not the other fold any map); for two closed genus-0 meshes of different shapes, try method spherical"
         }
         MethodPlan::Spherical(_) => {
             "Add anchors near these faces (they sit where a thin part of one surface meets a thick part of the other), or try method voronoi"
@@ -188,7 +188,7 @@ mod tests {
         let m = e.to_string();
         assert!(m.contains("(2 flipped faces)") && m.contains("target -> source: 2"), "{m}");
         assert!(m.contains("target face 7") && m.contains("target face 11") && m.contains("nearest anchor #"), "{m}");
-        assert!(m.contains("Add anchors"), "{m}");
+        assert!(m.contains("Add anchors") && m.contains("try method spherical"), "{m}");
     }
 
     /// A `homology` job whose meta-mesh was built keeps its fold-free overlay: the folded

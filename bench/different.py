@@ -2,7 +2,8 @@
 farthest-point anchors (ground truth i <-> i) and Sumner cat -> lion with 12 of the 55 markers
 (three farthest-point choices, the other 43 held out), judged by the shared evaluator.
 
-Usage: python3 bench/different.py SURFMAP_BINARY [FILTER]   (needs numpy + scipy)
+Usage: [METHOD=auto] python3 bench/different.py SURFMAP_BINARY [FILTER]   (needs numpy + scipy)
+  METHOD: the job's method (default voronoi)
 """
 import json
 import os
@@ -53,7 +54,7 @@ def main():
             if flt not in name:
                 continue
             sf = os.path.join(tmp, "spec.json")
-            json.dump({"method": "voronoi", "anchors": anchors}, open(sf, "w"))
+            json.dump({"method": os.environ.get("METHOD", "voronoi"), "anchors": anchors}, open(sf, "w"))
             out = os.path.join(tmp, "out")
             t0 = time.time()
             p = subprocess.run([binary, "map", s, t, "--spec", sf, "--out", out], capture_output=True, text=True)

@@ -44,20 +44,21 @@ fn a_torus_an_unknown_option_and_too_few_anchors_are_refused_with_their_codes() 
 }
 
 #[test]
-fn a_spec_without_method_runs_voronoi_on_a_closed_genus_0_pair_and_says_why() {
-    // `spherical` runs only by name until it maps same-shape genus-0 cases as well as `voronoi`
-    // (bench/README.md): `auto` picks the layout.
+fn a_spec_without_method_runs_spherical_on_two_closed_spheres_of_different_shapes_and_says_why() {
+    // The twisted copy is stretched too (1.6 × 0.9 × 0.7): its anchors' geodesics differ from
+    // the sphere's, so `auto` runs `spherical` (a copy of the same shape runs `voronoi`:
+    // `plan/same_shape.rs`).
     let (a, b) = (shapes::icosphere(3), shapes::twisted_icosphere(3));
     let spec = JobSpec::from_json(br#"{"anchors": [[0, 0], [7, 7], [40, 40], [300, 300]]}"#).unwrap();
     let (report, arts) = run_job(&spec, &[a, b], &mut NoProgress).unwrap();
-    let JobReport::Layout(r) = &report else { panic!("auto did not run voronoi") };
+    let JobReport::Spherical(r) = &report else { panic!("auto did not run spherical") };
     assert_eq!(r.pair.source_to_target.flipped_faces, 0);
     assert_eq!(r.pair.target_to_source.flipped_faces, 0);
     let metrics = arts.iter().find(|x| x.name == "metrics.json").expect("metrics.json");
     let v: serde_json::Value = serde_json::from_slice(&metrics.bytes).unwrap();
-    assert_eq!(v["method"], "voronoi");
-    assert_eq!(v["auto"]["method"], "voronoi");
-    assert!(v["auto"]["reason"].as_str().unwrap().contains("genus-0"), "{v}");
+    assert_eq!(v["method"], "spherical");
+    assert_eq!(v["auto"]["method"], "spherical");
+    assert!(v["auto"]["reason"].as_str().unwrap().contains("different shapes"), "{v}");
     // A torus pair goes to homology, and the chosen method's checks apply as if named.
     let torus = shapes::torus(12, 8, 2.0, 0.5);
     let spec = JobSpec::from_json(br#"{"method": "auto", "anchors": []}"#).unwrap();

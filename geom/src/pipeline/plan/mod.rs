@@ -9,6 +9,7 @@ pub(crate) mod anchor_points;
 mod input_ids;
 mod method;
 pub(crate) mod parts;
+pub mod same_shape;
 
 pub use method::MethodPlan;
 
@@ -83,9 +84,12 @@ impl<'a> Plan<'a> {
     /// `InputError::Invalid` for one the source lacks.
     pub fn new(spec: &JobSpec, meshes: &'a [Mesh], layouts: &'a [Option<InputLayout>]) -> Result<Plan<'a>> {
         let layouts: Vec<Option<&InputLayout>> = layouts.iter().map(Option::as_ref).collect();
-        let (spec, auto) = match spec {
+        let mut spheres = false;
+        let (spec, mut auto) = match spec {
             JobSpec::Auto(a) => {
                 let summaries: Vec<_> = meshes.iter().map(crate::topology::summary).collect();
+                let closed = |m: &crate::topology::Summary| m.components == 1 && m.boundary_loops == 0 && m.genus == 0;
+                spheres = summaries.len() == 2 && summaries.iter().all(closed);
                 let (spec, why) = a.resolve(&summaries)?;
                 (spec, Some(why))
             }
@@ -101,10 +105,60 @@ impl<'a> Plan<'a> {
             Some((inserted, snaps)) => (Cow::Owned(inserted), snaps),
             None => (Cow::Borrowed(meshes), Vec::new()),
         };
+        if spheres && let Some(why) = auto.as_mut() {
+            same_shape_or_spherical(&mut method, why, &meshes_run)?;
+        }
         let parts = match method.parts_rows() {
             Some((rows, boundaries)) => parts::plan(&meshes_run, &id_rows(rows)?, boundaries)?,
             None => None,
         };
         Ok(Plan { originals: meshes, layouts, meshes: meshes_run, method, output, auto, snaps, parts })
     }
+}
+
+/// `auto` on two closed connected genus-0 meshes picked `voronoi`; when the anchors say the
+/// meshes are different shapes ([`same_shape`]), `spherical` runs instead. The reason says
+/// which, with the figure.
+///
+/// # Errors
+/// `InputError::Anchors` for an anchor row that is not a vertex pair.
+fn same_shape_or_spherical(method: &mut MethodPlan, why: &mut AutoChoice, meshes: &[Mesh]) -> Result<()> {
+    use crate::pipeline::spec::{SphericalOptions, SphericalSpec};
+    let (MethodPlan::Layout(crate::pipeline::spec::Method::Voronoi, spec), [s, t]) = (&*method, meshes) else {
+        return Ok(());
+    };
+    let pairs: Vec<(crate::mesh::VertexId, crate::mesh::VertexId)> = id_rows(&spec.anchors)?
+        .iter()
+        .filter_map(|r| {
+            Some((crate::mesh::VertexId(u32::try_from(r[0]).ok()?), crate::mesh::VertexId(u32::try_from(r[1]).ok()?)))
+        })
+        .collect();
+    let Some(d) = same_shape::anchor_geodesic_difference(s, t, &pairs) else { return Ok(()) };
+    if d <= same_shape::DIFFERENT {
+        why.reason = format!(
+            "{}; the same shape (anchor geodesics differ by a median of {:.1}%, at most {:.0}%)",
+            why.reason,
+            100.0 * d,
+            100.0 * same_shape::DIFFERENT
+        );
+        return Ok(());
+    }
+    let o = &spec.options;
+    *method = MethodPlan::Spherical(SphericalSpec {
+        anchors: spec.anchors.clone(),
+        options: SphericalOptions {
+            metric_samples: o.metric_samples,
+            transfer: o.transfer.clone(),
+            inverse_morph: o.inverse_morph,
+        },
+    });
+    *why = AutoChoice {
+        method: "spherical",
+        reason: format!(
+            "two closed connected genus-0 meshes of different shapes (anchor geodesics differ by a median of {:.1}%, over {:.0}%)",
+            100.0 * d,
+            100.0 * same_shape::DIFFERENT
+        ),
+    };
+    Ok(())
 }

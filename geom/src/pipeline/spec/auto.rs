@@ -3,12 +3,14 @@
 //!
 //! - Feature curves: `homology`, the one method that maps them.
 //! - Closed meshes of genus ≥ 1: `homology` (canonical homology bases).
-//! - Anything else (genus-0 meshes, open or closed, one part or many): `voronoi`.
+//! - Anything else (genus-0 meshes, open or closed, one part or many): `voronoi`; but two
+//!   closed connected genus-0 meshes whose anchors say they are different shapes run
+//!   `spherical` (decided in the plan, which has the meshes: `plan/same_shape.rs`).
 //!
-//! `spherical` is run only by name: on same-shape genus-0 cases it does not yet beat `voronoi`
-//! (24 closed genus-0 `mkcase.py` cases of one draw: `voronoi` maps all 24, `spherical` 9; the
-//! others fold or leave images where the evaluator's nearest-face rule cannot see them), so the
-//! default stays with the path that maps them until it does.
+//! `spherical` does not yet beat `voronoi` on same-shape genus-0 cases (24 closed genus-0
+//! `mkcase.py` cases of one draw: `voronoi` maps all 24, `spherical` 9; the others fold or
+//! leave images where the evaluator's nearest-face rule cannot see them), while it maps the
+//! peer's different shapes with less distortion and cat -> horse, which `voronoi` folds.
 //!
 //! The choice is made once, from the meshes' summaries; the chosen method's own checks then
 //! apply as if it had been named.

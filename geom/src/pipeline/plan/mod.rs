@@ -106,7 +106,7 @@ impl<'a> Plan<'a> {
             None => (Cow::Borrowed(meshes), Vec::new()),
         };
         if spheres && let Some(why) = auto.as_mut() {
-            same_shape_or_spherical(&mut method, why, &meshes_run)?;
+            same_shape_or_spherical(&mut method, why, &meshes_run);
         }
         let parts = match method.parts_rows() {
             Some((rows, boundaries)) => parts::plan(&meshes_run, &id_rows(rows)?, boundaries)?,
@@ -119,21 +119,14 @@ impl<'a> Plan<'a> {
 /// `auto` on two closed connected genus-0 meshes picked `voronoi`; when the anchors say the
 /// meshes are different shapes ([`same_shape`]), `spherical` runs instead. The reason says
 /// which, with the figure.
-///
-/// # Errors
-/// `InputError::Anchors` for an anchor row that is not a vertex pair.
-fn same_shape_or_spherical(method: &mut MethodPlan, why: &mut AutoChoice, meshes: &[Mesh]) -> Result<()> {
+fn same_shape_or_spherical(method: &mut MethodPlan, why: &mut AutoChoice, meshes: &[Mesh]) {
     use crate::pipeline::spec::{SphericalOptions, SphericalSpec};
     let (MethodPlan::Layout(crate::pipeline::spec::Method::Voronoi, spec), [s, t]) = (&*method, meshes) else {
-        return Ok(());
+        return;
     };
-    let pairs: Vec<(crate::mesh::VertexId, crate::mesh::VertexId)> = id_rows(&spec.anchors)?
-        .iter()
-        .filter_map(|r| {
-            Some((crate::mesh::VertexId(u32::try_from(r[0]).ok()?), crate::mesh::VertexId(u32::try_from(r[1]).ok()?)))
-        })
-        .collect();
-    let Some(d) = same_shape::anchor_geodesic_difference(s, t, &pairs) else { return Ok(()) };
+    // Anchors the layout refuses: it reports them itself when it runs.
+    let Ok(pairs) = spec.validate(crate::pipeline::spec::Method::Voronoi, s, t) else { return };
+    let Some(d) = same_shape::anchor_geodesic_difference(s, t, &pairs) else { return };
     if d <= same_shape::DIFFERENT {
         why.reason = format!(
             "{}; the same shape (anchor geodesics differ by a median of {:.1}%, at most {:.0}%)",
@@ -141,7 +134,7 @@ fn same_shape_or_spherical(method: &mut MethodPlan, why: &mut AutoChoice, meshes
             100.0 * d,
             100.0 * same_shape::DIFFERENT
         );
-        return Ok(());
+        return;
     }
     let o = &spec.options;
     *method = MethodPlan::Spherical(SphericalSpec {
@@ -160,5 +153,4 @@ fn same_shape_or_spherical(method: &mut MethodPlan, why: &mut AutoChoice, meshes
             100.0 * same_shape::DIFFERENT
         ),
     };
-    Ok(())
 }

@@ -10,10 +10,9 @@
 //! still folds; `spherical` maps the peer's different shapes with less distortion and cat ->
 //! horse, which `voronoi` folds.
 
+use crate::geodesic::{VertexDijkstraOptions, vertex_dijkstra};
 use crate::mesh::{Mesh, VertexId};
 use rayon::prelude::*;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 
 /// Median relative difference of anchor geodesics above which two meshes are different shapes.
 pub const DIFFERENT: f64 = 0.09;
@@ -42,59 +41,18 @@ pub fn anchor_geodesic_difference(source: &Mesh, target: &Mesh, pairs: &[(Vertex
     r.get(r.len() / 2).copied()
 }
 
-/// Per anchor, its distance along edges to every other anchor, over `√area`.
+/// Per anchor, its distance along edges to every other anchor, over `√area`
+/// ([`vertex_dijkstra`] from each).
 fn between(mesh: &Mesh, anchors: &[VertexId]) -> Vec<Vec<f64>> {
     let scale = mesh.area().sqrt().max(f64::MIN_POSITIVE);
     anchors
         .par_iter()
         .map(|&a| {
-            let d = distances_from(mesh, a);
+            let d = vertex_dijkstra(mesh, &[(a, 0.0)], &VertexDijkstraOptions::default())
+                .map_or_else(|_| vec![f64::INFINITY; mesh.n_vertices()], |r| r.dist);
             anchors.iter().map(|b| d[b.idx()] / scale).collect()
         })
         .collect()
-}
-
-/// Dijkstra along the mesh's edges from `source`.
-fn distances_from(mesh: &Mesh, source: VertexId) -> Vec<f64> {
-    let mut dist = vec![f64::INFINITY; mesh.n_vertices()];
-    let mut heap = BinaryHeap::new();
-    dist[source.idx()] = 0.0;
-    heap.push(Near(0.0, source.0));
-    while let Some(Near(d, v)) = heap.pop() {
-        let v = VertexId(v);
-        if d > dist[v.idx()] {
-            continue;
-        }
-        let pv = mesh.position(v);
-        for w in mesh.vertex_neighbors(v) {
-            let nd = d + (mesh.position(w) - pv).norm();
-            if nd < dist[w.idx()] {
-                dist[w.idx()] = nd;
-                heap.push(Near(nd, w.0));
-            }
-        }
-    }
-    dist
-}
-
-/// A heap entry, nearest first.
-struct Near(f64, u32);
-
-impl PartialEq for Near {
-    fn eq(&self, o: &Self) -> bool {
-        self.0 == o.0
-    }
-}
-impl Eq for Near {}
-impl PartialOrd for Near {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Near {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.0.total_cmp(&self.0)
-    }
 }
 
 #[cfg(test)]

@@ -9,6 +9,8 @@ pub const MIN_SINGULAR_VALUE: f64 = 1e-12;
 pub const TINY: f64 = 1e-300;
 /// Relative residual a sparse solve must reach, or it is reported as a numerical failure.
 pub const SOLVE_RESIDUAL_REL: f64 = 1e-8;
+/// A line search gives up when its step, as a fraction of the Newton step, falls below this.
+pub const MIN_STEP: f64 = 1e-12;
 /// Barycentric coordinates within this of [0, 1] are clamped when locating points.
 pub const BARY_EPS: f64 = 1e-12;
 /// A planar triangle with signed area at or below this times the mean |area| is flipped or degenerate.

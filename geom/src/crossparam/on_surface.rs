@@ -91,12 +91,15 @@ impl<'a> OnSurface<'a> {
         if !up(f) {
             return false;
         }
-        let zero: Vec<usize> = (0..3).filter(|&k| b[k] <= TIE).collect();
-        match zero.as_slice() {
-            [] => true,
-            [k] => self.target.twin(crate::mesh::HalfedgeId::of(f, (k + 1) % 3)).is_none_or(|t| up(t.face())),
+        let zero = b.map(|x| x <= TIE);
+        match zero.iter().filter(|&&z| z).count() {
+            0 => true,
+            1 => {
+                let k = zero.iter().position(|&z| z).unwrap_or(0);
+                self.target.twin(crate::mesh::HalfedgeId::of(f, (k + 1) % 3)).is_none_or(|t| up(t.face()))
+            }
             _ => {
-                let corner = (0..3).find(|k| !zero.contains(k)).unwrap_or(0);
+                let corner = zero.iter().position(|&z| !z).unwrap_or(0);
                 self.target.vertex_faces(self.target.face(f)[corner]).all(up)
             }
         }
@@ -184,6 +187,13 @@ impl MapDomain for OnSurface<'_> {
             out.pos[v] = at;
         }
         Some(out)
+    }
+
+    fn restore(&self, trial: &mut Images, from: &Images, v: usize) -> bool {
+        trial.face[v] = from.face[v];
+        trial.bary[v] = from.bary[v];
+        trial.pos[v] = from.pos[v];
+        true
     }
 }
 

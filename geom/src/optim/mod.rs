@@ -4,7 +4,9 @@
 //! [`block_system`] the fixed-pattern sparse Newton system, and [`newton`] the optimizer.
 
 pub mod block_system;
+mod domain;
 pub mod isotropic;
+mod line_search;
 pub mod max_step;
 pub mod newton;
 pub mod sym_dirichlet;

@@ -16,8 +16,10 @@
 //! a metric factor per triangle (the target surface's metric, frozen for one step).
 
 use super::block_system::BlockSystem;
+pub use super::domain::{MapDomain, Plane};
+use super::line_search::{Stars, backtrack, held_search};
 use super::max_step::first_inversion;
-use super::sym_dirichlet::{IDENTITY, Mat2, RestTriangle};
+use super::sym_dirichlet::{Mat2, RestTriangle};
 use crate::error::{Error, InputError, Result};
 use crate::param::Uv;
 use crate::progress::Progress;
@@ -57,42 +59,14 @@ pub struct InjectiveNewtonResult {
     pub converged: bool,
 }
 
-/// Where a map's images live and how they move.
-pub trait MapDomain {
-    /// Every vertex's image (each in a chart of its own).
-    type State: Clone;
-    /// The corners of triangle `tri` in one chart and, per corner, the linear map that carries
-    /// that vertex's own-chart displacement into it.
-    fn element(&self, s: &Self::State, tri: [u32; 3]) -> ([Uv; 3], [Mat2; 3]);
-    /// The metric factor of triangle `tri` (its images are measured as `L J`), frozen for a
-    /// step.
-    fn metric(&self, _s: &Self::State, _tri: [u32; 3]) -> Mat2 {
-        IDENTITY
-    }
-    /// The state with every vertex moved by `d` (in its own chart); `None` where a vertex
-    /// cannot go.
-    fn moved(&self, s: &Self::State, d: &[Uv]) -> Option<Self::State>;
-}
-
-/// Images in the plane, one chart.
-pub struct Plane;
-
-impl MapDomain for Plane {
-    type State = Vec<Uv>;
-    fn element(&self, s: &Vec<Uv>, tri: [u32; 3]) -> ([Uv; 3], [Mat2; 3]) {
-        (tri.map(|v| s[v as usize]), [IDENTITY; 3])
-    }
-    fn moved(&self, s: &Vec<Uv>, d: &[Uv]) -> Option<Vec<Uv>> {
-        Some(s.iter().zip(d).map(|(p, q)| [p[0] + q[0], p[1] + q[1]]).collect())
-    }
-}
-
 /// A triangulation with rest shapes and fixed vertices, ready to optimize images of.
 pub struct InjectiveNewton {
     triangles: Vec<[u32; 3]>,
     rest: Vec<RestTriangle>,
     fixed: Vec<bool>,
     system: BlockSystem,
+    /// The triangles at each vertex, for the held line search.
+    stars: Stars,
 }
 
 impl InjectiveNewton {
@@ -106,7 +80,8 @@ impl InjectiveNewton {
             return Err(InputError::Invalid("triangles and rest shapes do not match".into()).into());
         }
         let (system, is_fixed) = BlockSystem::for_vertices(n_vertices, &triangles, fixed)?;
-        Ok(Self { triangles, rest, fixed: is_fixed, system })
+        let stars = Stars::new(n_vertices, &triangles);
+        Ok(Self { triangles, rest, fixed: is_fixed, system, stars })
     }
 
     /// Total energy with the domain's current metrics; `None` if any triangle is degenerate or
@@ -379,7 +354,8 @@ impl InjectiveNewton {
         }
         let t = (opts.step_fraction * self.first_inversion(d, s, dir)).min(1.0);
         if opts.hold_rounds > 0 {
-            return self.held_search(d, s, dir, t, energy, opts.hold_rounds);
+            let accept = |trial: &D::State| self.energy(d, trial).filter(|&e| e < energy);
+            return held_search(d, s, (dir, t), (&self.triangles, &self.stars), opts.hold_rounds, accept);
         }
         // The frozen metrics give the direction and the Armijo test; the step must also lower
         // the energy under the metrics where the trial lands (a long step crosses many target
@@ -393,86 +369,11 @@ impl InjectiveNewton {
     }
 }
 
-impl InjectiveNewton {
-    /// Triangles not positively oriented (exact predicate) in state `s`.
-    fn inverted<D: MapDomain>(&self, d: &D, s: &D::State) -> Vec<usize> {
-        let c = |p: Uv| robust::Coord { x: p[0], y: p[1] };
-        (0..self.triangles.len())
-            .filter(|&t| {
-                let [a, b, e] = d.element(s, self.triangles[t]).0;
-                robust::orient2d(c(a), c(b), c(e)) <= 0.0
-            })
-            .collect()
-    }
-
-    /// The line search with held vertices: a trial that inverts triangles is tried again at the
-    /// same length with their vertices held (up to `rounds` times), then halved. A trial is
-    /// accepted when every triangle is positive and the energy is lower.
-    fn held_search<D: MapDomain>(
-        &self,
-        d: &D,
-        s: &D::State,
-        dir: &[Uv],
-        mut t: f64,
-        energy: f64,
-        rounds: usize,
-    ) -> Option<(D::State, f64, usize)> {
-        let mut dir = dir.to_vec();
-        let mut refused = 0;
-        let mut held = 0;
-        while t > 1e-12 {
-            let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
-            if let Some(trial) = d.moved(s, &step) {
-                let bad = self.inverted(d, &trial);
-                if bad.is_empty() {
-                    if let Some(e) = self.energy(d, &trial).filter(|&e| e < energy) {
-                        return Some((trial, e, refused));
-                    }
-                } else if held < rounds {
-                    held += 1;
-                    refused += 1;
-                    for tri in bad {
-                        for v in self.triangles[tri] {
-                            dir[v as usize] = [0.0; 2];
-                        }
-                    }
-                    continue;
-                }
-            }
-            refused += 1;
-            t *= 0.5;
-        }
-        None
-    }
-}
-
-/// Halves the step `t` along `dir` from its start until `accept` gives the trial an energy;
-/// returns the trial, that energy and the refused trials.
-fn backtrack<D: MapDomain>(
-    d: &D,
-    s: &D::State,
-    dir: &[Uv],
-    mut t: f64,
-    accept: impl Fn(&D::State, f64) -> Option<f64>,
-) -> Option<(D::State, f64, usize)> {
-    let mut refused = 0;
-    while t > 1e-12 {
-        let step: Vec<Uv> = dir.iter().map(|q| [t * q[0], t * q[1]]).collect();
-        if let Some(trial) = d.moved(s, &step)
-            && let Some(e) = accept(&trial, t)
-        {
-            return Some((trial, e, refused));
-        }
-        refused += 1;
-        t *= 0.5;
-    }
-    None
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mesh::shapes;
+    use crate::optim::sym_dirichlet::IDENTITY;
     use crate::progress::NoProgress;
 
     /// The flat `n` × `n` grid as its own rest shape, boundary fixed; and its rest positions.
@@ -529,6 +430,53 @@ mod tests {
         }
         let ideal = 4.0 * opt.rest.iter().map(|r| r.area()).sum::<f64>();
         assert!(last < start && (last - ideal) / ideal < 1e-3, "start {start}, end {last}, ideal {ideal}");
+    }
+
+    /// A plane whose moves shear (every other vertex also rises, the rest sink, by twice its
+    /// step's length): the linear step bound cannot see the inversions that adds, so the line
+    /// search holds vertices. `restore`
+    /// says whether holding one restores it in place.
+    struct Bent {
+        restore: bool,
+    }
+
+    impl MapDomain for Bent {
+        type State = Vec<Uv>;
+        fn element(&self, s: &Vec<Uv>, tri: [u32; 3]) -> ([Uv; 3], [Mat2; 3]) {
+            Plane.element(s, tri)
+        }
+        fn moved(&self, s: &Vec<Uv>, d: &[Uv]) -> Option<Vec<Uv>> {
+            let shear = |v: usize, q: &Uv| if v.is_multiple_of(2) { 2.0 } else { -2.0 } * q[0].hypot(q[1]);
+            Some(s.iter().zip(d).enumerate().map(|(v, (p, q))| [p[0] + q[0], p[1] + q[1] + shear(v, q)]).collect())
+        }
+        fn restore(&self, trial: &mut Vec<Uv>, from: &Vec<Uv>, v: usize) -> bool {
+            if self.restore {
+                trial[v] = from[v];
+            }
+            self.restore
+        }
+    }
+
+    /// Holding a vertex in place (restoring it and re-testing its star) takes the same steps
+    /// as moving the whole state anew; every accepted step stays injective.
+    #[test]
+    fn held_vertices_restored_in_place_take_the_same_steps() {
+        let (opt, rest_pos) = grid_problem(8);
+        let pi = std::f64::consts::PI;
+        let start: Vec<Uv> =
+            rest_pos.iter().map(|p| [p[0] + 0.3 * (pi * p[0]).sin() * (pi * p[1]).sin(), p[1]]).collect();
+        let opts = InjectiveNewtonOptions { max_iterations: 1, hold_rounds: 30, ..Default::default() };
+        let (mut a, mut b) = (start.clone(), start);
+        let mut backtracks = 0;
+        for _ in 0..20 {
+            let ra = opt.minimize(&Bent { restore: true }, &mut a, &opts, &NoProgress).unwrap();
+            let rb = opt.minimize(&Bent { restore: false }, &mut b, &opts, &NoProgress).unwrap();
+            assert_eq!(a, b);
+            assert_eq!((ra.iterations, ra.backtracks), (rb.iterations, rb.backtracks));
+            assert!(opt.is_injective(&Plane, &a), "an accepted step inverted a triangle");
+            backtracks += ra.backtracks;
+        }
+        assert!(backtracks > 0, "the shear never held a vertex: the test tests nothing");
     }
 
     /// A step toward inversion: a descent direction that would carry the centre vertex of a

@@ -13,6 +13,9 @@ pub struct VertexDijkstraOptions<'a> {
     pub max_distance: Option<f64>,
     /// Stop as soon as this vertex is settled.
     pub target: Option<VertexId>,
+    /// Stop as soon as every one of these vertices is settled (distances to them are final;
+    /// farther vertices may be left unreached).
+    pub until_settled: Option<&'a [VertexId]>,
     /// Vertices that may not be entered (indexed by vertex), except `target`: paths kept
     /// vertex-disjoint from earlier paths.
     pub blocked: Option<&'a [bool]>,
@@ -100,6 +103,14 @@ pub fn vertex_dijkstra(
         }
     }
     let allowed = |f: FaceId| opts.faces.is_none_or(|m| m[f.idx()]);
+    // Vertices still to settle before stopping early (each counted once).
+    let mut waiting = vec![false; if opts.until_settled.is_some() { nv } else { 0 }];
+    let mut left = 0usize;
+    for &v in opts.until_settled.unwrap_or(&[]) {
+        if v.idx() < nv && !std::mem::replace(&mut waiting[v.idx()], true) {
+            left += 1;
+        }
+    }
     let max_d = opts.max_distance.unwrap_or(f64::INFINITY);
     while let Some((d, u)) = heap.pop() {
         let ui = u as usize;
@@ -112,6 +123,12 @@ pub fn vertex_dijkstra(
         done[ui] = true;
         if opts.target == Some(VertexId(u)) {
             break;
+        }
+        if opts.until_settled.is_some() && std::mem::replace(&mut waiting[ui], false) {
+            left -= 1;
+            if left == 0 {
+                break;
+            }
         }
         let pu = mesh.position(VertexId(u));
         for h in mesh.outgoing(VertexId(u)) {
@@ -161,6 +178,20 @@ fn relax(
 mod tests {
     use super::*;
     use crate::mesh::shapes;
+
+    /// Stopping once some vertices are settled leaves their distances as the full search's.
+    #[test]
+    fn stopping_once_vertices_are_settled_keeps_their_distances() {
+        let m = shapes::icosphere(3);
+        let full = vertex_dijkstra(&m, &[(VertexId(0), 0.0)], &Default::default()).unwrap();
+        let want = [VertexId(5), VertexId(17), VertexId(5)];
+        let opts = VertexDijkstraOptions { until_settled: Some(&want), ..Default::default() };
+        let part = vertex_dijkstra(&m, &[(VertexId(0), 0.0)], &opts).unwrap();
+        for v in want {
+            assert_eq!(part.dist[v.idx()], full.dist[v.idx()]);
+        }
+        assert!(part.dist.iter().any(|d| d.is_infinite()), "the search did not stop early");
+    }
 
     #[test]
     fn grid_distances_are_graph_distances() {

@@ -42,17 +42,33 @@ pub fn anchor_geodesic_difference(source: &Mesh, target: &Mesh, pairs: &[(Vertex
 }
 
 /// Per anchor, its distance along edges to every other anchor, over `√area`
-/// ([`vertex_dijkstra`] from each).
+/// ([`vertex_dijkstra`] from each, stopped once the anchors after it are settled: the
+/// distances are symmetric, so anchor `i` measures the pairs `(i, j > i)`).
 fn between(mesh: &Mesh, anchors: &[VertexId]) -> Vec<Vec<f64>> {
     let scale = mesh.area().sqrt().max(f64::MIN_POSITIVE);
-    anchors
-        .par_iter()
-        .map(|&a| {
-            let d = vertex_dijkstra(mesh, &[(a, 0.0)], &VertexDijkstraOptions::default())
-                .map_or_else(|_| vec![f64::INFINITY; mesh.n_vertices()], |r| r.dist);
-            anchors.iter().map(|b| d[b.idx()] / scale).collect()
+    let k = anchors.len();
+    let rows: Vec<Vec<f64>> = (0..k)
+        .into_par_iter()
+        .map(|i| {
+            let later = &anchors[i + 1..];
+            if later.is_empty() {
+                return Vec::new();
+            }
+            let opts = VertexDijkstraOptions { until_settled: Some(later), ..Default::default() };
+            vertex_dijkstra(mesh, &[(anchors[i], 0.0)], &opts).map_or_else(
+                |_| vec![f64::INFINITY; later.len()],
+                |r| later.iter().map(|b| r.dist[b.idx()] / scale).collect(),
+            )
         })
-        .collect()
+        .collect();
+    let mut d = vec![vec![0.0; k]; k];
+    for (i, row) in rows.iter().enumerate() {
+        for (j, &x) in row.iter().enumerate() {
+            d[i][i + 1 + j] = x;
+            d[i + 1 + j][i] = x;
+        }
+    }
+    d
 }
 
 #[cfg(test)]

@@ -174,17 +174,27 @@ impl MapDomain for OnSurface<'_> {
     }
 
     fn moved(&self, s: &Images, d: &[Uv]) -> Option<Images> {
+        use rayon::prelude::*;
         let mut out = s.clone();
-        for (v, q) in d.iter().enumerate() {
-            if q[0] == 0.0 && q[1] == 0.0 {
-                continue;
+        // Each image walks on its own (in parallel); an image whose walk does not end (too
+        // long a step) stays put for this trial.
+        let walked: Vec<Option<(FaceId, [f64; 3], P3)>> = d
+            .par_iter()
+            .enumerate()
+            .map(|(v, q)| {
+                if q[0] == 0.0 && q[1] == 0.0 {
+                    return None;
+                }
+                let [b0, b1] = self.frames[s.face[v].idx()];
+                self.walk(s.face[v], s.pos[v], b0 * q[0] + b1 * q[1])
+            })
+            .collect();
+        for (v, w) in walked.into_iter().enumerate() {
+            if let Some((f, b, at)) = w {
+                out.face[v] = f;
+                out.bary[v] = b;
+                out.pos[v] = at;
             }
-            let [b0, b1] = self.frames[s.face[v].idx()];
-            // An image whose walk does not end (too long a step) stays put for this trial.
-            let Some((f, b, at)) = self.walk(s.face[v], s.pos[v], b0 * q[0] + b1 * q[1]) else { continue };
-            out.face[v] = f;
-            out.bary[v] = b;
-            out.pos[v] = at;
         }
         Some(out)
     }

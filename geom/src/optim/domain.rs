@@ -4,10 +4,11 @@
 use super::sym_dirichlet::{IDENTITY, Mat2};
 use crate::param::Uv;
 
-/// Where a map's images live and how they move.
-pub trait MapDomain {
+/// Where a map's images live and how they move. Shared across threads: triangles are
+/// measured in parallel (each result kept in triangle order, so sums are the serial ones).
+pub trait MapDomain: Sync {
     /// Every vertex's image (each in a chart of its own).
-    type State: Clone;
+    type State: Clone + Sync;
     /// The corners of triangle `tri` in one chart and, per corner, the linear map that carries
     /// that vertex's own-chart displacement into it.
     fn element(&self, s: &Self::State, tri: [u32; 3]) -> ([Uv; 3], [Mat2; 3]);

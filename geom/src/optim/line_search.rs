@@ -6,6 +6,7 @@
 use super::domain::MapDomain;
 use crate::param::Uv;
 use crate::tol::MIN_STEP;
+use rayon::prelude::*;
 
 /// The triangles at each vertex (compressed rows).
 pub struct Stars {
@@ -44,7 +45,7 @@ fn positive(x: [Uv; 3]) -> bool {
 
 /// Triangles not positively oriented (exact predicate) in state `s`.
 pub fn inverted<D: MapDomain>(d: &D, s: &D::State, triangles: &[[u32; 3]]) -> Vec<usize> {
-    (0..triangles.len()).filter(|&t| !positive(d.element(s, triangles[t]).0)).collect()
+    (0..triangles.len()).into_par_iter().filter(|&t| !positive(d.element(s, triangles[t]).0)).collect()
 }
 
 /// Triangles around `vertices` not positively oriented (exact predicate) in state `s`.

@@ -23,7 +23,11 @@ use super::sym_dirichlet::{Mat2, RestTriangle};
 use crate::error::{Error, InputError, Result};
 use crate::param::Uv;
 use crate::progress::Progress;
+use rayon::prelude::*;
 use serde::Serialize;
+
+/// Triangles whose derivatives are computed in parallel before they are added to the system.
+const ASSEMBLY_CHUNK: usize = 8192;
 
 /// Options for [`InjectiveNewton::minimize`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,7 +91,7 @@ impl InjectiveNewton {
     /// Total energy with the domain's current metrics; `None` if any triangle is degenerate or
     /// inverted.
     pub fn energy<D: MapDomain>(&self, d: &D, s: &D::State) -> Option<f64> {
-        let metrics: Vec<Mat2> = self.triangles.iter().map(|&tri| d.metric(s, tri)).collect();
+        let metrics: Vec<Mat2> = self.triangles.par_iter().map(|&tri| d.metric(s, tri)).collect();
         self.energy_with(d, s, &metrics)
     }
 
@@ -97,7 +101,8 @@ impl InjectiveNewton {
 
     /// The energy, or with `Some(ε)` the untangling energy (finite on inverted triangles).
     fn energy_eps<D: MapDomain>(&self, d: &D, s: &D::State, metrics: &[Mat2], eps: Option<f64>) -> Option<f64> {
-        (0..self.triangles.len())
+        let each: Vec<Option<f64>> = (0..self.triangles.len())
+            .into_par_iter()
             .map(|t| {
                 let x = d.element(s, self.triangles[t]).0;
                 match eps {
@@ -105,7 +110,8 @@ impl InjectiveNewton {
                     Some(e) => self.rest[t].energy_eps(x, &metrics[t], e),
                 }
             })
-            .sum()
+            .collect();
+        each.into_iter().sum()
     }
 
     /// `det(L J)` of every triangle (rest-normalized: 1 for an isometry).
@@ -146,7 +152,7 @@ impl InjectiveNewton {
         max_iterations: usize,
         progress: &dyn Progress,
     ) -> Result<usize> {
-        let metrics: Vec<Mat2> = self.triangles.iter().map(|&tri| d.metric(s, tri)).collect();
+        let metrics: Vec<Mat2> = self.triangles.par_iter().map(|&tri| d.metric(s, tri)).collect();
         let min_det = |s: &D::State| self.dets(d, s, &metrics).into_iter().fold(f64::INFINITY, f64::min);
         let mut m = min_det(s);
         let mut eps = (1e-8 + 0.04 * m.min(0.0).powi(2)).sqrt();
@@ -247,7 +253,7 @@ impl InjectiveNewton {
         for _ in 0..opts.max_iterations {
             progress.check()?;
             // The metrics are frozen for the step: the energy it lowers is this one.
-            let metrics: Vec<Mat2> = self.triangles.iter().map(|&tri| d.metric(s, tri)).collect();
+            let metrics: Vec<Mat2> = self.triangles.par_iter().map(|&tri| d.metric(s, tri)).collect();
             let energy = self
                 .energy_with(d, s, &metrics)
                 .ok_or_else(|| Error::Internal("an inverted triangle inside the optimization".into()))?;
@@ -289,20 +295,32 @@ impl InjectiveNewton {
         let n = self.system.len();
         let mut grad = vec![0.0; n];
         let mut values = self.system.zero_values();
-        for (t, &tri) in self.triangles.iter().enumerate() {
-            let (x, m) = d.element(s, tri);
-            let derivatives = match eps {
-                None => self.rest[t].derivatives_in(x, &metrics[t], &m),
-                Some(e) => self.rest[t].derivatives_eps(x, &metrics[t], &m, e),
-            };
-            let (_, g, h) =
-                derivatives.ok_or_else(|| Error::Internal("an inverted triangle inside the optimization".into()))?;
-            for (k, &i) in self.system.dofs(t).iter().enumerate() {
-                if i != usize::MAX {
-                    grad[i] += g[k];
+        // Per-triangle derivatives in parallel, a chunk at a time (bounded memory), added into
+        // the system in triangle order.
+        let n_tri = self.triangles.len();
+        for start in (0..n_tri).step_by(ASSEMBLY_CHUNK) {
+            let chunk = start..(start + ASSEMBLY_CHUNK).min(n_tri);
+            let parts: Vec<_> = chunk
+                .clone()
+                .into_par_iter()
+                .map(|t| {
+                    let (x, m) = d.element(s, self.triangles[t]);
+                    match eps {
+                        None => self.rest[t].derivatives_in(x, &metrics[t], &m),
+                        Some(e) => self.rest[t].derivatives_eps(x, &metrics[t], &m, e),
+                    }
+                })
+                .collect();
+            for (t, derivatives) in chunk.zip(parts) {
+                let (_, g, h) = derivatives
+                    .ok_or_else(|| Error::Internal("an inverted triangle inside the optimization".into()))?;
+                for (k, &i) in self.system.dofs(t).iter().enumerate() {
+                    if i != usize::MAX {
+                        grad[i] += g[k];
+                    }
                 }
+                self.system.add_block(&mut values, t, &h);
             }
-            self.system.add_block(&mut values, t, &h);
         }
         let rhs: Vec<f64> = grad.iter().map(|g| -g).collect();
         // The projected Hessian is PSD; a tiny shift makes it definite, grown if needed.
@@ -324,7 +342,7 @@ impl InjectiveNewton {
     /// triangle's chart).
     fn first_inversion<D: MapDomain>(&self, d: &D, s: &D::State, dir: &[Uv]) -> f64 {
         self.triangles
-            .iter()
+            .par_iter()
             .map(|&tri| {
                 let (x, m) = d.element(s, tri);
                 let mut k = 0;
@@ -335,7 +353,7 @@ impl InjectiveNewton {
                 });
                 first_inversion(x, moves)
             })
-            .fold(f64::INFINITY, f64::min)
+            .reduce(|| f64::INFINITY, f64::min)
     }
 
     /// The accepted state, its energy and the refused trials; `None` when no step along the

@@ -38,7 +38,8 @@ impl Stars {
     }
 }
 
-fn positive(x: [Uv; 3]) -> bool {
+/// Whether the triangle `x` is positively oriented (exact predicate).
+pub fn positive(x: [Uv; 3]) -> bool {
     let c = |p: Uv| robust::Coord { x: p[0], y: p[1] };
     robust::orient2d(c(x[0]), c(x[1]), c(x[2])) > 0.0
 }

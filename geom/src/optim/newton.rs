@@ -17,7 +17,7 @@
 
 use super::block_system::BlockSystem;
 pub use super::domain::{MapDomain, Plane};
-use super::line_search::{Stars, backtrack, held_search};
+use super::line_search::{Stars, backtrack, held_search, inverted, positive};
 use super::max_step::first_inversion;
 use super::sym_dirichlet::{Mat2, RestTriangle};
 use crate::error::{Error, InputError, Result};
@@ -128,14 +128,7 @@ impl InjectiveNewton {
 
     /// Triangles not positively oriented under the exact predicate.
     pub fn folded<D: MapDomain>(&self, d: &D, s: &D::State) -> usize {
-        let c = |p: Uv| robust::Coord { x: p[0], y: p[1] };
-        self.triangles
-            .iter()
-            .filter(|&&tri| {
-                let [a, b, e] = d.element(s, tri).0;
-                robust::orient2d(c(a), c(b), c(e)) <= 0.0
-            })
-            .count()
+        inverted(d, s, &self.triangles).len()
     }
 
     /// Untangles a start with inverted triangles by the method of Garanzha, Kaporin, Kudryavtseva,
@@ -219,11 +212,7 @@ impl InjectiveNewton {
 
     /// Whether every triangle is positively oriented in its chart under the exact predicate.
     pub fn is_injective<D: MapDomain>(&self, d: &D, s: &D::State) -> bool {
-        let c = |p: Uv| robust::Coord { x: p[0], y: p[1] };
-        self.triangles.iter().all(|&tri| {
-            let [a, b, e] = d.element(s, tri).0;
-            robust::orient2d(c(a), c(b), c(e)) > 0.0
-        })
+        self.triangles.par_iter().all(|&tri| positive(d.element(s, tri).0))
     }
 
     /// Minimizes the energy from the injective start `s`, in place; every accepted step keeps
